@@ -9,6 +9,7 @@
 //   5. drift correction   project positions, then velocities, back onto the joint constraints
 //   6. check              stop with a report if any component's state is not finite
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,7 +34,7 @@ struct ExternalLoads {
   void clear();
 };
 
-class TreeSolver;  // dynamics/tree_solver.hpp
+struct StepWorkspace;  // solver factorization and scratch (dynamics/simulation.cpp)
 
 class Simulation {
  public:
@@ -72,7 +73,7 @@ class Simulation {
   DampingSpec damping_;
   std::optional<SimulationFailure> failure_;
   long long steps_ = 0;
-  TreeSolver* solver_;  // owned; pimpl keeps Eigen fixed-size blocks out of this header
+  std::unique_ptr<StepWorkspace> work_;  // sized once; step() never allocates
 };
 
 }  // namespace aloft

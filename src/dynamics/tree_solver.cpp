@@ -1,0 +1,133 @@
+#include "dynamics/tree_solver.hpp"
+
+#include <Eigen/Dense>
+
+namespace aloft {
+
+namespace {
+
+// World inertia R diag(I) R^T of a body with principal moments `moments` and orientation `q`.
+Mat3 world_inertia_of(const Quat& q, const Vec3& moments) {
+  const Mat3 r = q.toRotationMatrix();
+  return r * moments.asDiagonal() * r.transpose();
+}
+
+// A^T K A for A = [E, -[s]x] (3x6), added to the 6x6 block `d`: the contribution of an eliminated
+// child joint to its parent's articulated block. (J_kp = -A; the sign cancels.)
+void add_joint_contribution(Mat6& d, const Mat3& k, const Vec3& s) {
+  const Mat3 sx = skew(s);
+  const Mat3 k_sx = k * sx;            // K [s]x
+  d.topLeftCorner<3, 3>() += k;
+  d.topRightCorner<3, 3>() -= k_sx;    // -K [s]x
+  d.bottomLeftCorner<3, 3>() -= k_sx.transpose();  // ([s]x)^T K^T = -[s]x K ... written as -(K[s]x)^T
+  d.bottomRightCorner<3, 3>() -= sx * k_sx;        // -[s]x K [s]x
+}
+
+}  // namespace
+
+TreeSolver::TreeSolver(const Model& model)
+    : model_(model),
+      n_(model.count),
+      child_arm_(n_, Vec3::Zero()),
+      parent_arm_(n_, Vec3::Zero()),
+      inertia_(n_, Mat3::Zero()),
+      articulated_(n_, Mat6::Zero()),
+      chol_(n_),
+      w_(n_, Mat63::Zero()),
+      k_inv_(n_, Mat3::Zero()),
+      g_(n_, Vec6::Zero()),
+      y_(n_, Vec6::Zero()),
+      a_(n_, Vec3::Zero()) {}
+
+void TreeSolver::factor(const State& state) {
+  const std::vector<int>& parent = model_.parent;
+
+  // Base to tip: world inertias, lever arms, and each body's own mass block M_i.
+  for (int i = 1; i < n_; ++i) {
+    const int p = parent[i];
+    inertia_[i] = world_inertia_of(state.orientation[i], model_.principal_moments[i]);
+    child_arm_[i] = state.orientation[i] * model_.joint_in_child[i];
+    parent_arm_[i] = state.orientation[p] * model_.joint_in_parent[i];
+    Mat6& d = articulated_[i];
+    d.setZero();
+    d.topLeftCorner<3, 3>().diagonal().setConstant(model_.mass[i]);
+    d.bottomRightCorner<3, 3>() = inertia_[i];
+  }
+
+  // Tip to base: eliminate body i, then its joint i, folding both into the parent's block.
+  for (int i = n_ - 1; i >= 1; --i) {
+    chol_[i].compute(articulated_[i]);
+    // W_i = D_i^-1 J_ii^T with J_ii^T = [E; [r_i]x].
+    Mat63 jt;
+    jt.topRows<3>().setIdentity();
+    jt.bottomRows<3>() = skew(child_arm_[i]);
+    w_[i] = chol_[i].solve(jt);
+    // K_i = J_ii W_i = W_top - [r_i]x W_bottom.
+    const Mat3 k = w_[i].topRows<3>() - skew(child_arm_[i]) * w_[i].bottomRows<3>();
+    k_inv_[i] = k.inverse();
+    const int p = parent[i];
+    if (p != 0) add_joint_contribution(articulated_[p], k_inv_[i], parent_arm_[i]);
+  }
+}
+
+void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
+                       std::vector<Vec3>* lambda) {
+  const std::vector<int>& parent = model_.parent;
+  for (int i = 1; i < n_; ++i) g_[i] = f[i];
+
+  // Tip to base: y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i), and g_p += J_ip^T a_i.
+  for (int i = n_ - 1; i >= 1; --i) {
+    y_[i] = chol_[i].solve(g_[i]);
+    const Vec3 r = child_arm_[i];
+    const Vec3 j_y = y_[i].head<3>() + y_[i].tail<3>().cross(r);  // v + w x r
+    a_[i] = k_inv_[i] * (c[i] - j_y);
+    const int p = parent[i];
+    if (p != 0) {
+      g_[p].head<3>() -= a_[i];
+      g_[p].tail<3>() -= parent_arm_[i].cross(a_[i]);
+    }
+  }
+
+  // Base to tip: lambda_i = a_i - K_i^-1 J_ip u_p, u_i = y_i + W_i lambda_i.
+  u[0].setZero();
+  for (int i = 1; i < n_; ++i) {
+    const int p = parent[i];
+    Vec3 lam = a_[i];
+    if (p != 0) {
+      const Vec3 parent_point_velocity = u[p].head<3>() + u[p].tail<3>().cross(parent_arm_[i]);
+      lam += k_inv_[i] * parent_point_velocity;  // J_ip u_p = -(v_p + w_p x s_i)
+    }
+    u[i] = y_[i] + w_[i] * lam;
+    if (lambda) (*lambda)[i] = lam;
+  }
+}
+
+Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state) {
+  const int m = model.count - 1;  // moving bodies 1..n-1 -> blocks 0..m-1
+  const int size = 9 * m;
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(size, size);
+  for (int i = 1; i < model.count; ++i) {
+    const int b = 6 * (i - 1);
+    h.block<3, 3>(b, b) = model.mass[i] * Mat3::Identity();
+    h.block<3, 3>(b + 3, b + 3) = world_inertia_of(state.orientation[i], model.principal_moments[i]);
+  }
+  for (int k = 1; k < model.count; ++k) {
+    const int row = 6 * m + 3 * (k - 1);
+    const Vec3 r = state.orientation[k] * model.joint_in_child[k];
+    Eigen::Matrix<double, 3, 6> jc;
+    jc << Mat3::Identity(), -skew(r);
+    h.block<3, 6>(row, 6 * (k - 1)) = jc;
+    h.block<6, 3>(6 * (k - 1), row) = jc.transpose();
+    const int p = model.parent[k];
+    if (p != 0) {
+      const Vec3 s = state.orientation[p] * model.joint_in_parent[k];
+      Eigen::Matrix<double, 3, 6> jp;
+      jp << -Mat3::Identity(), skew(s);
+      h.block<3, 6>(row, 6 * (p - 1)) = jp;
+      h.block<6, 3>(6 * (p - 1), row) = jp.transpose();
+    }
+  }
+  return h;
+}
+
+}  // namespace aloft

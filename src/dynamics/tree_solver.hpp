@@ -1,0 +1,70 @@
+#pragma once
+// Baraff's linear-time solve of the joint KKT system of a tree of rigid bodies.
+//
+// Unknowns: u_i = (v_i, w_i) per moving body (6), lambda_k per joint (3). Equations:
+//     M_i u_i = f_i + sum_k J_ki^T lambda_k          (momentum: f = applied wrench, J^T lambda = joint forces)
+//     sum_i J_ki u_i = c_k                             (joint rows)
+// with M_i = diag(m_i E, I_i) (world axes). Joint k joins child body k to its parent p = parent[k]; with
+// world lever arms r_k (child's centre of mass -> joint) and s_k (parent's centre of mass -> joint),
+//     C_k = (x_k + r_k) - (x_p + s_k),   J_kk = [E, -[r_k]x],   J_kp = -[E, -[s_k]x].
+// A joint to the fixed component (index 0) is a nail: it has no parent block.
+//
+// Baraff (SIGGRAPH 1996) orders the body and joint nodes of H = [M J^T; J 0] children first; the block
+// LDL^T factorization then has no fill-in. Eliminating child body k and then its joint k gives, for every
+// body, the articulated block
+//     D_k = M_k + sum over child joints c of J_ck^T K_c^-1 J_ck,      K_k = J_kk D_k^-1 J_kk^T,
+// which are exactly Baraff's D (body node) and -D (joint node) blocks; L_kp = D_k^-1 J_kp is applied
+// implicitly. factor() computes them tip to base; solve() does one tip-to-base and one base-to-tip sweep.
+// Every block is 6x6, 6x3 or 3x3, so both cost O(n). The arrays are sized once; nothing allocates
+// after construction.
+
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "aloft/state.hpp"
+
+namespace aloft {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat63 = Eigen::Matrix<double, 6, 3>;
+
+class TreeSolver {
+ public:
+  explicit TreeSolver(const Model& model);
+
+  // Form and factor H at the pose `state` (orientations give the world inertias and lever arms).
+  void factor(const State& state);
+
+  // Solve with the last factorization. f: per body (force N, torque N m), world; c: per joint (3);
+  // entries for index 0 are ignored. Writes u (per body; u[0] = 0) and, if given, lambda (per joint).
+  void solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
+             std::vector<Vec3>* lambda = nullptr);
+
+  // World lever arms at the factored pose: centre of mass of body i -> joint i, and of parent -> joint i.
+  const std::vector<Vec3>& child_arm() const { return child_arm_; }
+  const std::vector<Vec3>& parent_arm() const { return parent_arm_; }
+  // World inertia tensors at the factored pose.
+  const std::vector<Mat3>& world_inertia() const { return inertia_; }
+
+ private:
+  const Model& model_;
+  int n_;
+  std::vector<Vec3> child_arm_;     // r_k, world
+  std::vector<Vec3> parent_arm_;    // s_k, world
+  std::vector<Mat3> inertia_;       // I_i, world
+  std::vector<Mat6> articulated_;   // D_i, filled tip to base
+  std::vector<Eigen::LLT<Mat6>> chol_;
+  std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
+  std::vector<Mat3> k_inv_;         // K_i^-1
+  std::vector<Vec6> g_;             // solve scratch: condensed right-hand sides
+  std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
+  std::vector<Vec3> a_;             // solve scratch: joint terms
+};
+
+// The symmetric KKT matrix H = [M J^T; J 0] written out densely (moving bodies 1..n-1 as 6-blocks, then
+// joints as 3-blocks), for tests: H [u; -lambda] = [f; c] is the system TreeSolver solves.
+Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
+
+}  // namespace aloft
