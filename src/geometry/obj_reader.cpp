@@ -1,0 +1,234 @@
+// A hand-written Wavefront OBJ reader: vertices and faces only, with line and column numbers in its
+// errors. It reads untrusted bytes: every token is bounds-checked, numbers are parsed with from_chars
+// (no locale, no exceptions), and the work is linear in the input's length.
+
+#include "geometry/obj_reader.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "aloft/error.hpp"
+#include "aloft/geometry.hpp"
+
+namespace aloft {
+namespace {
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+
+// 1-based column of byte `offset` in a line; lines longer than INT_MAX bytes report INT_MAX.
+int column_of(size_t offset) {
+  return offset < static_cast<size_t>(INT_MAX) ? static_cast<int>(offset) + 1 : INT_MAX;
+}
+
+// A whitespace-separated word of a line and its 1-based column (in bytes).
+struct Token {
+  std::string_view text;
+  int column = 0;
+};
+
+// The token quoted for a message: at most 40 bytes, bytes that are not printable ASCII shown as '?'.
+std::string quoted(std::string_view s) {
+  constexpr size_t kMax = 40;
+  std::string out = "'";
+  for (size_t i = 0; i < s.size() && i < kMax; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    out += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
+  }
+  if (s.size() > kMax) out += "...";
+  return out + "'";
+}
+
+// from_chars does not take a leading '+'; OBJ writers sometimes emit one.
+std::string_view without_plus(std::string_view s) {
+  if (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
+  return s;
+}
+
+enum class NumberResult { ok, not_a_number, not_finite };
+
+NumberResult parse_double(std::string_view s, double& value) {
+  s = without_plus(s);
+  const char* end = s.data() + s.size();
+  const auto r = std::from_chars(s.data(), end, value, std::chars_format::general);
+  if (r.ptr != end || s.empty()) return NumberResult::not_a_number;
+  if (r.ec == std::errc::result_out_of_range) {
+    // Too large (non-finite) or too small (rounds to zero or a subnormal: acceptable); strtod tells which.
+    const std::string copy(s);
+    value = std::strtod(copy.c_str(), nullptr);
+    return std::isfinite(value) ? NumberResult::ok : NumberResult::not_finite;
+  }
+  if (r.ec != std::errc()) return NumberResult::not_a_number;
+  return std::isfinite(value) ? NumberResult::ok : NumberResult::not_finite;
+}
+
+// A whole token as a decimal integer (optional sign).
+bool parse_integer(std::string_view s, long long& value, bool& overflow) {
+  s = without_plus(s);
+  const char* end = s.data() + s.size();
+  const auto r = std::from_chars(s.data(), end, value);
+  overflow = r.ec == std::errc::result_out_of_range && r.ptr == end;
+  return !s.empty() && r.ec == std::errc() && r.ptr == end;
+}
+
+class ObjParser {
+ public:
+  explicit ObjParser(const std::string& file) : file_(file) {}
+
+  TriangleMesh parse(const std::string& text) {
+    size_t pos = 0;
+    int line = 0;
+    while (pos < text.size()) {
+      // Lines end with \n, \r\n or \r.
+      size_t end = pos;
+      while (end < text.size() && text[end] != '\n' && text[end] != '\r') ++end;
+      if (line == INT_MAX) fail(line, 0, "file has too many lines");
+      ++line;
+      parse_line(std::string_view(text.data() + pos, end - pos), line);
+      // Skip the terminator text[end]: '\n', '\r', or the pair "\r\n".
+      pos = end;
+      if (pos < text.size()) {
+        const bool carriage_return = text[pos] == '\r';
+        ++pos;
+        if (carriage_return && pos < text.size() && text[pos] == '\n') ++pos;
+      }
+    }
+    if (mesh_.triangles.empty()) fail(0, 0, "file has no faces");
+    return std::move(mesh_);
+  }
+
+ private:
+  [[noreturn]] void fail(int line, int column, const std::string& problem) const {
+    throw InputError(file_, SourcePlace{"", line, column}, problem);
+  }
+
+  // Splits the line (up to a '#' comment) into tokens_.
+  void tokenize(std::string_view line) {
+    tokens_.clear();
+    const size_t hash = line.find('#');
+    if (hash != std::string_view::npos) line = line.substr(0, hash);
+    size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && is_space(line[i])) ++i;
+      if (i >= line.size()) break;
+      const size_t start = i;
+      while (i < line.size() && !is_space(line[i])) ++i;
+      tokens_.push_back({line.substr(start, i - start), column_of(start)});
+    }
+  }
+
+  void parse_line(std::string_view text, int line) {
+    tokenize(text);
+    if (tokens_.empty()) return;
+    const std::string_view keyword = tokens_[0].text;
+    if (keyword == "v")
+      parse_vertex(line, column_of(text.size()));
+    else if (keyword == "f")
+      parse_face(line);
+    // Everything else (vn, vt, vp, o, g, s, usemtl, mtllib, l, p, curves...) carries nothing we use.
+  }
+
+  // "v x y z [w]" (some writers append colours "r g b": further numbers are accepted and ignored).
+  void parse_vertex(int line, int end_column) {
+    if (tokens_.size() < 4)
+      fail(line, end_column,
+           "expected 3 coordinates after 'v', got " + std::to_string(tokens_.size() - 1));
+    Vec3 p;
+    for (size_t k = 1; k < tokens_.size(); ++k) {
+      double value = 0;
+      switch (parse_double(tokens_[k].text, value)) {
+        case NumberResult::ok:
+          break;
+        case NumberResult::not_a_number:
+          fail(line, tokens_[k].column, "expected a number after 'v', got " + quoted(tokens_[k].text));
+        case NumberResult::not_finite:
+          fail(line, tokens_[k].column, "non-finite coordinate " + quoted(tokens_[k].text));
+      }
+      if (k <= 3) p[static_cast<int>(k - 1)] = value;
+    }
+    if (mesh_.vertices.size() >= static_cast<size_t>(INT_MAX)) fail(line, 1, "too many vertices");
+    mesh_.vertices.push_back(p);
+  }
+
+  // One face vertex "a", "a/b", "a/b/c" or "a//c": returns the 0-based vertex index.
+  int face_vertex(const Token& token, int line) {
+    const std::string_view s = token.text;
+    const size_t slash = s.find('/');
+    const std::string_view index_text = s.substr(0, slash);
+    // The texture and normal indices, if any, must be integers (or empty) but are not used.
+    if (slash != std::string_view::npos) {
+      std::string_view rest = s.substr(slash + 1);
+      const size_t slash2 = rest.find('/');
+      const std::string_view tex = rest.substr(0, slash2);
+      const std::string_view normal = slash2 == std::string_view::npos ? std::string_view() : rest.substr(slash2 + 1);
+      long long ignored = 0;
+      bool overflow = false;
+      const bool tex_ok = tex.empty() ? slash2 != std::string_view::npos : parse_integer(tex, ignored, overflow);
+      const bool normal_ok = slash2 == std::string_view::npos || parse_integer(normal, ignored, overflow);
+      if (!tex_ok || !normal_ok) fail(line, token.column, "malformed face vertex " + quoted(s));
+    }
+    long long index = 0;
+    bool overflow = false;
+    const long long count = static_cast<long long>(mesh_.vertices.size());
+    if (!parse_integer(index_text, index, overflow)) {
+      if (overflow)
+        fail(line, token.column,
+             "face index " + quoted(index_text) + " out of range (" + std::to_string(count) + " vertices so far)");
+      fail(line, token.column, "malformed face vertex " + quoted(s));
+    }
+    if (index == 0) fail(line, token.column, "face index 0 is invalid: OBJ indices start at 1");
+    // Positive indices count from 1; negative ones back from the latest vertex (-1 is the last).
+    const long long resolved = index > 0 ? index - 1 : count + index;
+    if (resolved < 0 || resolved >= count)
+      fail(line, token.column,
+           "face index " + std::to_string(index) + " out of range (" + std::to_string(count) + " vertices so far)");
+    return static_cast<int>(resolved);
+  }
+
+  void parse_face(int line) {
+    if (tokens_.size() < 4)
+      fail(line, tokens_[0].column,
+           "face with fewer than 3 vertices (" + std::to_string(tokens_.size() - 1) + ")");
+    face_.clear();
+    for (size_t k = 1; k < tokens_.size(); ++k) face_.push_back(face_vertex(tokens_[k], line));
+    // Fan from the first vertex: exact for convex planar polygons, the usual OBJ convention.
+    for (size_t k = 1; k + 1 < face_.size(); ++k) mesh_.triangles.push_back({face_[0], face_[k], face_[k + 1]});
+  }
+
+  const std::string& file_;
+  TriangleMesh mesh_;
+  std::vector<Token> tokens_;  // reused across lines
+  std::vector<int> face_;      // reused across faces
+};
+
+}  // namespace
+
+TriangleMesh parse_obj_text(const std::string& text, const std::string& file_name_for_messages) {
+  return ObjParser(file_name_for_messages).parse(text);
+}
+
+TriangleMesh read_obj(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, {}, "cannot open file: it is a directory");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    throw InputError(path, {}, std::string("cannot open file: ") + (err ? std::strerror(err) : "unknown error"));
+  }
+  std::ostringstream content;
+  content << in.rdbuf();
+  if (in.bad()) throw InputError(path, {}, "cannot read file");
+  return parse_obj_text(content.str(), path);
+}
+
+}  // namespace aloft
