@@ -1,13 +1,17 @@
 #pragma once
 // Stepping a mobile in time: constraint dynamics with Baraff's linear-time tree factorization.
 //
-// One step (fixed h, default 1 ms), top to bottom in Simulation::step():
-//   1. applied forces     gravity, external (wind), air damping, implicit-midpoint gyroscopic torque
-//   2. factor             children-first block LDL^T of the joint KKT matrix at the current pose, O(n)
-//   3. accelerations      solve for accelerations and joint forces (with the centripetal term)
-//   4. integrate          semi-implicit (symplectic) Euler; orientations as unit quaternions
-//   5. drift correction   project positions, then velocities, back onto the joint constraints
+// One step (fixed h, default 1 ms), top to bottom in Simulation::step(); the pose's factorization is
+// carried over from the previous step:
+//   1. applied forces     gravity, external loads (wind), air damping, implicit-midpoint gyroscopic torque
+//   2. predict            unconstrained velocities, warm-started with the last step's joint impulses
+//   3. joint impulses     SHAKE: Newton iterations on the joint impulses until the *new* positions
+//                         satisfy every joint (|C| < 1e-12 m), each iteration one O(n) tree solve
+//   4. factor             children-first block LDL^T of the joint KKT matrix at the new pose, O(n)
+//   5. velocity projection  RATTLE: velocities projected (mass-weighted) onto the joints' tangent space
 //   6. check              stop with a report if any component's state is not finite
+// Steps 2-5 are the constrained symplectic Euler method (Hairer, Lubich & Wanner, Geometric Numerical
+// Integration, VII.1): first order, symplectic for the translational part, so energy does not drift.
 
 #include <memory>
 #include <optional>
@@ -53,7 +57,8 @@ class Simulation {
 
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
-  State& state() { return state_; }
+  // Change the state from outside (reset, a user's drag): the next step re-factors at the new pose.
+  State& mutable_state();
   ExternalLoads& loads() { return loads_; }
 
   double timestep() const { return timestep_; }
@@ -66,6 +71,8 @@ class Simulation {
   long long step_count() const { return steps_; }
 
  private:
+  void applied_wrenches(const State& state, std::vector<Eigen::Matrix<double, 6, 1>>& f) const;
+
   const Model& model_;
   State state_;
   ExternalLoads loads_;

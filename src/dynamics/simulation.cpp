@@ -3,7 +3,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "dynamics/gyroscopic.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace aloft {
@@ -18,6 +17,15 @@ void ExternalLoads::clear() {
   std::fill(torque.begin(), torque.end(), Vec3::Zero());
 }
 
+namespace {
+
+// Joint positions must agree to this (m) before a step is accepted; the Newton iteration on the
+// joint impulses converges linearly at rate ~h|w|, so this costs 2-3 solves per step.
+constexpr double kJointTolerance = 1e-12;
+constexpr int kMaxJointIterations = 8;
+
+}  // namespace
+
 // Everything step() needs, sized once per model.
 struct StepWorkspace {
   explicit StepWorkspace(const Model& model)
@@ -25,25 +33,36 @@ struct StepWorkspace {
         next(rest_state(model)),
         wrench(model.count, Vec6::Zero()),
         rows(model.count, Vec3::Zero()),
-        unknowns(model.count, Vec6::Zero()) {}
+        correction(model.count, Vec6::Zero()),
+        impulse(model.count, Vec3::Zero()),
+        step_impulse(model.count, Vec3::Zero()),
+        drift_map(model.count, Mat3::Identity()) {}
   TreeSolver solver;
+  bool factored = false;         // solver holds the factorization at the current state's pose
   State next;                    // the state being computed; swapped in when it is finite
-  std::vector<Vec6> wrench;      // right-hand side f per body (force, torque), world
-  std::vector<Vec3> rows;        // right-hand side c per joint
-  std::vector<Vec6> unknowns;    // solution u per body
+  std::vector<Vec6> wrench;      // scratch per body (force, torque), world
+  std::vector<Vec3> rows;        // scratch per joint
+  std::vector<Vec6> correction;  // solver output per body
+  std::vector<Vec3> impulse;     // joint impulses of the last step (N s), for the warm start
+  std::vector<Vec3> step_impulse;  // joint impulses being accumulated in this step
+  std::vector<Mat3> drift_map;   // per body: kicked angular velocity -> drift angular velocity
 };
 
 namespace {
 
 // Rotation by the rotation vector `theta` (rad, world) as a unit quaternion: exp(theta / 2).
 Quat rotation_quaternion(const Vec3& theta) {
-  const double angle = theta.norm();
-  if (angle < 1e-8) {
-    // Taylor series; the neglected terms are O(angle^3) ~ 1e-24.
-    return Quat(1.0 - angle * angle / 8.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z());
+  const double a2 = theta.squaredNorm();
+  if (a2 < 1e-4) {
+    // Taylor series of cos(a/2) and sin(a/2)/a to a^4; the first neglected terms are below
+    // a^6/46080 < 3e-17 for a < 1e-2.
+    const double c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
+    const double s = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
+    return Quat(c, s * theta.x(), s * theta.y(), s * theta.z());
   }
-  const double s = std::sin(0.5 * angle) / angle;
-  return Quat(std::cos(0.5 * angle), s * theta.x(), s * theta.y(), s * theta.z());
+  const double a = std::sqrt(a2);
+  const double s = std::sin(0.5 * a) / a;
+  return Quat(std::cos(0.5 * a), s * theta.x(), s * theta.y(), s * theta.z());
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
@@ -64,75 +83,128 @@ Simulation::Simulation(const Model& model, State initial)
 
 Simulation::~Simulation() = default;
 
-void Simulation::set_timestep(double seconds) { timestep_ = seconds; }
+State& Simulation::mutable_state() {
+  work_->factored = false;
+  std::fill(work_->impulse.begin(), work_->impulse.end(), Vec3::Zero());
+  return state_;
+}
+
+void Simulation::set_timestep(double seconds) {
+  timestep_ = seconds;
+  std::fill(work_->impulse.begin(), work_->impulse.end(), Vec3::Zero());
+}
+
+// Applied wrenches at `state` (world): gravity, external loads, air damping. There is no gyroscopic
+// term: the kicks change the world angular momentum L, whose rate is the torque alone; the rotation
+// of the inertia tensor is in the drift (step 3).
+void Simulation::applied_wrenches(const State& state, std::vector<Vec6>& f) const {
+  const std::vector<Mat3>& inertia = work_->solver.world_inertia();
+  for (int i = 1; i < model_.count; ++i) {
+    const double m = model_.mass[i];
+    const Vec3& w = state.angular[i];
+    f[i].head<3>() = m * model_.gravity + loads_.force[i] - damping_.linear * m * state.velocity[i];
+    f[i].tail<3>() = loads_.torque[i] - damping_.angular * (inertia[i] * w);
+  }
+}
 
 bool Simulation::step() {
   const int n = model_.count;
   const double h = timestep_;
   const std::vector<int>& parent = model_.parent;
+  StepWorkspace& work = *work_;
   const State& now = state_;
-  State& next = work_->next;
-  TreeSolver& solver = work_->solver;
-  std::vector<Vec6>& f = work_->wrench;
-  std::vector<Vec3>& c = work_->rows;
-  std::vector<Vec6>& u = work_->unknowns;
+  State& next = work.next;
+  TreeSolver& solver = work.solver;
+  std::vector<Vec6>& f = work.wrench;
+  std::vector<Vec3>& c = work.rows;
+  std::vector<Vec6>& du = work.correction;
 
-  // 1. Factor H at the current pose (world inertias, lever arms).
-  solver.factor(now);
-  const std::vector<Vec3>& r = solver.child_arm();
+  if (!work.factored) solver.factor(now);
+  const std::vector<Vec3>& r = solver.child_arm();    // at the factored pose
   const std::vector<Vec3>& s = solver.parent_arm();
-  const std::vector<Mat3>& inertia = solver.world_inertia();
+  const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
-  // 2. Applied wrenches: gravity, external loads, air damping, gyroscopic torque (implicit midpoint).
+  // 1. Applied wrenches at the current state.
+  applied_wrenches(now, f);
+
+  // 2. Half kick: applied impulses (h/2) f plus last step's joint impulses P (warm start), which act on
+  //    the child as (P, r x P) and on the parent as -(P, s x P).
   for (int i = 1; i < n; ++i) {
-    const double m = model_.mass[i];
-    const Vec3& w = now.angular[i];
-    f[i].head<3>() = m * model_.gravity + loads_.force[i] - damping_.linear * m * now.velocity[i];
-    f[i].tail<3>() = loads_.torque[i] - damping_.angular * (inertia[i] * w) +
-                     midpoint_gyroscopic_torque(now.orientation[i], model_.principal_moments[i], w, h);
+    f[i] *= 0.5 * h;
+    f[i].head<3>() += work.impulse[i];
+    f[i].tail<3>() += r[i].cross(work.impulse[i]);
+    const int p = parent[i];
+    if (p != 0) {
+      f[p].head<3>() -= work.impulse[i];
+      f[p].tail<3>() -= s[i].cross(work.impulse[i]);
+    }
+  }
+  for (int i = 1; i < n; ++i) {
+    next.velocity[i] = now.velocity[i] + f[i].head<3>() / model_.mass[i];
+    next.angular[i] = now.angular[i] + inverse_inertia[i] * f[i].tail<3>();
+    work.step_impulse[i] = work.impulse[i];
   }
 
-  // 3. Accelerations. Differentiating C_k twice: J a = -(w_k x (w_k x r_k) - w_p x (w_p x s_k)).
+  // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
+  // the implicit midpoint of that flow: q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
+  // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
+  // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
+  // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
   for (int i = 1; i < n; ++i) {
-    const Vec3& wc = now.angular[i];
-    const Vec3& wp = now.angular[parent[i]];
-    c[i] = wp.cross(wp.cross(s[i])) - wc.cross(wc.cross(r[i]));
-  }
-  solver.solve(f, c, u);
-
-  // 4. Integrate: semi-implicit Euler (velocities first, positions with the new velocities); the
-  //    orientation turns by the exact rotation of the new angular velocity over h.
-  next.time = now.time + h;
-  for (int i = 1; i < n; ++i) {
-    next.velocity[i] = now.velocity[i] + h * u[i].head<3>();
-    next.angular[i] = now.angular[i] + h * u[i].tail<3>();
-    next.position[i] = now.position[i] + h * next.velocity[i];
-    next.orientation[i] = (rotation_quaternion(h * next.angular[i]) * now.orientation[i]).normalized();
+    const Quat half = (rotation_quaternion(0.5 * h * next.angular[i]) * now.orientation[i]).normalized();
+    const Mat3 rot = half.toRotationMatrix();
+    work.drift_map[i] = rot * model_.principal_moments[i].cwiseInverse().asDiagonal() * rot.transpose() *
+                        solver.world_inertia()[i];
   }
 
-  // 5. Drift correction (post-stabilisation, Cline & Pai 2003), reusing the factorization of step 1.
-  //    Positions: the mass-weighted smallest displacement d with J d = -C(next).
-  for (int i = 1; i < n; ++i) f[i].setZero();
-  for (int i = 1; i < n; ++i) c[i] = joint_on_parent(model_, next, i) - joint_on_child(model_, next, i);
-  solver.solve(f, c, u);
-  for (int i = 1; i < n; ++i) {
-    next.position[i] += u[i].head<3>();
-    next.orientation[i] = (rotation_quaternion(u[i].tail<3>()) * next.orientation[i]).normalized();
+  // 3. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
+  //    of the half kick so that every joint closes at the new pose (SHAKE). Newton's method with the
+  //    current pose's factorization: solving J du = -C(x')/h moves the joints by -C to first order.
+  for (int iteration = 0;; ++iteration) {
+    double worst = 0;
+    for (int i = 1; i < n; ++i) {
+      next.position[i] = now.position[i] + h * next.velocity[i];
+      next.orientation[i] =
+          (rotation_quaternion(h * (work.drift_map[i] * next.angular[i])) * now.orientation[i]).normalized();
+    }
+    for (int i = 1; i < n; ++i) {
+      const Vec3 gap = joint_on_parent(model_, next, i) - joint_on_child(model_, next, i);
+      worst = std::max(worst, gap.cwiseAbs().maxCoeff());
+      c[i] = gap / h;
+    }
+    if (!(worst > kJointTolerance) || iteration == kMaxJointIterations) break;
+    for (int i = 1; i < n; ++i) f[i].setZero();
+    solver.solve(f, c, du, &work.rows);  // rows now hold this iteration's joint impulses
+    for (int i = 1; i < n; ++i) {
+      next.velocity[i] += du[i].head<3>();
+      next.angular[i] += du[i].tail<3>();
+      work.step_impulse[i] += c[i];
+    }
   }
-  //    Velocities: remove the joint-velocity error J(next) u(next) the same way.
+  std::swap(work.impulse, work.step_impulse);
+
+  // 4. Factor at the new pose (also used by the next step). Angular velocities follow the new
+  //    inertia at unchanged angular momentum: w' = I'^-1 I w.
+  for (int i = 1; i < n; ++i) next.angular[i] = solver.world_inertia()[i] * next.angular[i];
+  solver.factor(next);
+  for (int i = 1; i < n; ++i) next.angular[i] = inverse_inertia[i] * next.angular[i];
+
+  // 5. Second half kick with the new pose's forces, and joint impulses that make the velocities tangent
+  //    to the joints at the new pose (RATTLE): M du = (h/2) f' + J'^T mu,  J' (v + du) = 0.
+  applied_wrenches(next, f);
   for (int i = 1; i < n; ++i) {
     const int p = parent[i];
-    const Vec3 rc = next.orientation[i] * model_.joint_in_child[i];
-    const Vec3 rp = next.orientation[p] * model_.joint_in_parent[i];
-    const Vec3 child_point = next.velocity[i] + next.angular[i].cross(rc);
-    const Vec3 parent_point = next.velocity[p] + next.angular[p].cross(rp);
+    const Vec3 child_point = next.velocity[i] + next.angular[i].cross(r[i]);
+    const Vec3 parent_point = next.velocity[p] + next.angular[p].cross(s[i]);
     c[i] = parent_point - child_point;
+    f[i] *= 0.5 * h;
   }
-  solver.solve(f, c, u);
+  solver.solve(f, c, du);
   for (int i = 1; i < n; ++i) {
-    next.velocity[i] += u[i].head<3>();
-    next.angular[i] += u[i].tail<3>();
+    next.velocity[i] += du[i].head<3>();
+    next.angular[i] += du[i].tail<3>();
   }
+  next.time = now.time + h;
 
   // 6. Check: a non-finite state stops the simulation with a report; the last good state stays.
   double sum = 0;
@@ -153,10 +225,12 @@ bool Simulation::step() {
           << "angular velocity; the last finite state is kept";
       fail.message = msg.str();
       failure_ = fail;
+      work.factored = false;  // the factorization is of the rejected pose
       return false;
     }
   }
   std::swap(state_, next);
+  work.factored = true;
   ++steps_;
   return true;
 }

@@ -12,6 +12,13 @@ Mat3 world_inertia_of(const Quat& q, const Vec3& moments) {
   return r * moments.asDiagonal() * r.transpose();
 }
 
+// Both R diag(I) R^T and R diag(1/I) R^T.
+void world_inertia_pair(const Quat& q, const Vec3& moments, Mat3& inertia, Mat3& inverse) {
+  const Mat3 r = q.toRotationMatrix();
+  inertia = r * moments.asDiagonal() * r.transpose();
+  inverse = r * moments.cwiseInverse().asDiagonal() * r.transpose();
+}
+
 // A^T K A for A = [E, -[s]x] (3x6), added to the 6x6 block `d`: the contribution of an eliminated
 // child joint to its parent's articulated block. (J_kp = -A; the sign cancels.)
 void add_joint_contribution(Mat6& d, const Mat3& k, const Vec3& s) {
@@ -31,6 +38,7 @@ TreeSolver::TreeSolver(const Model& model)
       child_arm_(n_, Vec3::Zero()),
       parent_arm_(n_, Vec3::Zero()),
       inertia_(n_, Mat3::Zero()),
+      inverse_inertia_(n_, Mat3::Zero()),
       articulated_(n_, Mat6::Zero()),
       chol_(n_),
       w_(n_, Mat63::Zero()),
@@ -45,7 +53,7 @@ void TreeSolver::factor(const State& state) {
   // Base to tip: world inertias, lever arms, and each body's own mass block M_i.
   for (int i = 1; i < n_; ++i) {
     const int p = parent[i];
-    inertia_[i] = world_inertia_of(state.orientation[i], model_.principal_moments[i]);
+    world_inertia_pair(state.orientation[i], model_.principal_moments[i], inertia_[i], inverse_inertia_[i]);
     child_arm_[i] = state.orientation[i] * model_.joint_in_child[i];
     parent_arm_[i] = state.orientation[p] * model_.joint_in_parent[i];
     Mat6& d = articulated_[i];

@@ -45,8 +45,9 @@ class TreeSolver {
   // World lever arms at the factored pose: centre of mass of body i -> joint i, and of parent -> joint i.
   const std::vector<Vec3>& child_arm() const { return child_arm_; }
   const std::vector<Vec3>& parent_arm() const { return parent_arm_; }
-  // World inertia tensors at the factored pose.
+  // World inertia tensors and their inverses at the factored pose.
   const std::vector<Mat3>& world_inertia() const { return inertia_; }
+  const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
 
  private:
   const Model& model_;
@@ -54,6 +55,7 @@ class TreeSolver {
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
+  std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
   std::vector<Mat6> articulated_;   // D_i, filled tip to base
   std::vector<Eigen::LLT<Mat6>> chol_;
   std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
