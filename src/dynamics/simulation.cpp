@@ -21,7 +21,7 @@ namespace {
 
 // Joint positions must agree to this (m) before a step is accepted; the Newton iteration on the
 // joint impulses converges linearly at rate ~h|w|, so this costs 2-3 solves per step.
-constexpr double kJointTolerance = 1e-12;
+constexpr double kJointTolerance = 1e-10;
 constexpr int kMaxJointIterations = 8;
 
 }  // namespace
@@ -172,7 +172,7 @@ bool Simulation::step() {
       worst = std::max(worst, gap.cwiseAbs().maxCoeff());
       c[i] = gap / h;
     }
-    if (!(worst > kJointTolerance) || iteration == kMaxJointIterations) break;
+    if (!(worst > kJointTolerance) || iteration == kMaxJointIterations) { break; }
     for (int i = 1; i < n; ++i) f[i].setZero();
     solver.solve(f, c, du, &work.rows);  // rows now hold this iteration's joint impulses
     for (int i = 1; i < n; ++i) {

@@ -19,17 +19,6 @@ void world_inertia_pair(const Quat& q, const Vec3& moments, Mat3& inertia, Mat3&
   inverse = r * moments.cwiseInverse().asDiagonal() * r.transpose();
 }
 
-// A^T K A for A = [E, -[s]x] (3x6), added to the 6x6 block `d`: the contribution of an eliminated
-// child joint to its parent's articulated block. (J_kp = -A; the sign cancels.)
-void add_joint_contribution(Mat6& d, const Mat3& k, const Vec3& s) {
-  const Mat3 sx = skew(s);
-  const Mat3 k_sx = k * sx;            // K [s]x
-  d.topLeftCorner<3, 3>() += k;
-  d.topRightCorner<3, 3>() -= k_sx;    // -K [s]x
-  d.bottomLeftCorner<3, 3>() -= k_sx.transpose();  // ([s]x)^T K^T = -[s]x K ... written as -(K[s]x)^T
-  d.bottomRightCorner<3, 3>() -= sx * k_sx;        // -[s]x K [s]x
-}
-
 }  // namespace
 
 TreeSolver::TreeSolver(const Model& model)
@@ -39,8 +28,11 @@ TreeSolver::TreeSolver(const Model& model)
       parent_arm_(n_, Vec3::Zero()),
       inertia_(n_, Mat3::Zero()),
       inverse_inertia_(n_, Mat3::Zero()),
-      articulated_(n_, Mat6::Zero()),
-      chol_(n_),
+      block_a_(n_, Mat3::Zero()),
+      block_b_(n_, Mat3::Zero()),
+      block_c_(n_, Mat3::Zero()),
+      has_children_(n_, 0),
+      d_inv_(n_, Mat6::Zero()),
       w_(n_, Mat63::Zero()),
       k_inv_(n_, Mat3::Zero()),
       g_(n_, Vec6::Zero()),
@@ -50,31 +42,53 @@ TreeSolver::TreeSolver(const Model& model)
 void TreeSolver::factor(const State& state) {
   const std::vector<int>& parent = model_.parent;
 
-  // Base to tip: world inertias, lever arms, and each body's own mass block M_i.
+  // Base to tip: world inertias, lever arms, and each body's own mass block M_i = diag(m E, I).
   for (int i = 1; i < n_; ++i) {
     const int p = parent[i];
     world_inertia_pair(state.orientation[i], model_.principal_moments[i], inertia_[i], inverse_inertia_[i]);
     child_arm_[i] = state.orientation[i] * model_.joint_in_child[i];
     parent_arm_[i] = state.orientation[p] * model_.joint_in_parent[i];
-    Mat6& d = articulated_[i];
-    d.setZero();
-    d.topLeftCorner<3, 3>().diagonal().setConstant(model_.mass[i]);
-    d.bottomRightCorner<3, 3>() = inertia_[i];
+    block_a_[i] = model_.mass[i] * Mat3::Identity();
+    block_b_[i].setZero();
+    block_c_[i] = inertia_[i];
+    has_children_[i] = 0;
   }
 
-  // Tip to base: eliminate body i, then its joint i, folding both into the parent's block.
+  // Tip to base: invert D_i, eliminate joint i, fold A^T K_i^-1 A (A = [E, -[s_i]x]) into the parent.
   for (int i = n_ - 1; i >= 1; --i) {
-    chol_[i].compute(articulated_[i]);
-    // W_i = D_i^-1 J_ii^T with J_ii^T = [E; [r_i]x].
-    Mat63 jt;
-    jt.topRows<3>().setIdentity();
-    jt.bottomRows<3>() = skew(child_arm_[i]);
-    w_[i] = chol_[i].solve(jt);
-    // K_i = J_ii W_i = W_top - [r_i]x W_bottom.
-    const Mat3 k = w_[i].topRows<3>() - skew(child_arm_[i]) * w_[i].bottomRows<3>();
-    k_inv_[i] = k.inverse();
+    Mat6& d_inv = d_inv_[i];
+    if (!has_children_[i]) {
+      // A leaf: D_i = M_i, so D_i^-1 = diag(E / m, I^-1).
+      d_inv.setZero();
+      d_inv.topLeftCorner<3, 3>().diagonal().setConstant(1.0 / model_.mass[i]);
+      d_inv.bottomRightCorner<3, 3>() = inverse_inertia_[i];
+    } else {
+      // D^-1 = [A^-1 + T S^-1 T^T, -T S^-1; -(T S^-1)^T, S^-1], T = A^-1 B, S = C - B^T T.
+      const Mat3 a_inv = block_a_[i].inverse();
+      const Mat3 t = a_inv * block_b_[i];
+      const Mat3 s_inv = (block_c_[i] - block_b_[i].transpose() * t).inverse();
+      const Mat3 t_s = t * s_inv;
+      d_inv.topLeftCorner<3, 3>() = a_inv + t_s * t.transpose();
+      d_inv.topRightCorner<3, 3>() = -t_s;
+      d_inv.bottomLeftCorner<3, 3>() = -t_s.transpose();
+      d_inv.bottomRightCorner<3, 3>() = s_inv;
+    }
+    // W_i = D_i^-1 J_ii^T with J_ii^T = [E; [r_i]x]; K_i = J_ii W_i = W_top - [r_i]x W_bottom.
+    const Mat3 rx = skew(child_arm_[i]);
+    w_[i] = d_inv.leftCols<3>() + d_inv.rightCols<3>() * rx;
+    const Mat3 k = w_[i].topRows<3>() - rx * w_[i].bottomRows<3>();
+    const Mat3 k_inv = k.inverse();
+    k_inv_[i] = k_inv;
     const int p = parent[i];
-    if (p != 0) add_joint_contribution(articulated_[p], k_inv_[i], parent_arm_[i]);
+    if (p != 0) {
+      // A^T K^-1 A = [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
+      const Mat3 sx = skew(parent_arm_[i]);
+      const Mat3 k_sx = k_inv * sx;
+      block_a_[p] += k_inv;
+      block_b_[p] -= k_sx;
+      block_c_[p] -= sx * k_sx;
+      has_children_[p] = 1;
+    }
   }
 }
 
@@ -85,7 +99,7 @@ void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, s
 
   // Tip to base: y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i), and g_p += J_ip^T a_i.
   for (int i = n_ - 1; i >= 1; --i) {
-    y_[i] = chol_[i].solve(g_[i]);
+    y_[i] = d_inv_[i] * g_[i];
     const Vec3 r = child_arm_[i];
     const Vec3 j_y = y_[i].head<3>() + y_[i].tail<3>().cross(r);  // v + w x r
     a_[i] = k_inv_[i] * (c[i] - j_y);

@@ -20,7 +20,6 @@
 
 #include <vector>
 
-#include <Eigen/Cholesky>
 
 #include "aloft/state.hpp"
 
@@ -56,8 +55,13 @@ class TreeSolver {
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
   std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
-  std::vector<Mat6> articulated_;   // D_i, filled tip to base
-  std::vector<Eigen::LLT<Mat6>> chol_;
+  // D_i = [A B; B^T C] is accumulated in 3x3 blocks, tip to base, then inverted through the Schur
+  // complement of A (all 3x3 work).
+  std::vector<Mat3> block_a_;       // m E + sum K_c^-1                    (symmetric)
+  std::vector<Mat3> block_b_;       // - sum K_c^-1 [s_c]x
+  std::vector<Mat3> block_c_;       // I + sum -[s_c]x K_c^-1 [s_c]x       (symmetric)
+  std::vector<char> has_children_;  // whether any joint was folded into the blocks
+  std::vector<Mat6> d_inv_;         // D_i^-1
   std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
   std::vector<Mat3> k_inv_;         // K_i^-1
   std::vector<Vec6> g_;             // solve scratch: condensed right-hand sides
