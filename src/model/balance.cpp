@@ -68,8 +68,12 @@ Eigen::VectorXd balance_factors(const Mat3& horizontal, double own_mass, const V
   for (int j = 0; j < k; ++j) b.col(j + 1) = column(child_mass[j], child_joint[j]);
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(k + 1);
   if (b.norm() == 0) return ones;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(b);
-  cod.setThreshold(1e-10);
+  // Rank decision: directions closer than 1e-6 (relative) count as the same line. Drawn coordinates
+  // carry ~1e-9 m of rounding on ~0.1 m arms, so pieces drawn in one vertical plane must come out
+  // rank one; the horizontal imbalance this tolerates is ~1e-6 x 0.1 m, far below kBalanceTolerance.
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(b.rows(), b.cols());
+  cod.setThreshold(1e-6);
+  cod.compute(b);
   return ones - cod.pseudoInverse() * (b * ones);
 }
 

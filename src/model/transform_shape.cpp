@@ -2,26 +2,36 @@
 
 namespace aloft::internal {
 
+namespace {
+
+struct RigidMotion {
+  const Mat3& rotation;
+  const Vec3& translation;
+  Vec3 point(const Vec3& p) const { return rotation * p + translation; }
+
+  Shape operator()(Sphere s) const { s.center = point(s.center); return s; }
+  Shape operator()(Wire w) const { w.from = point(w.from); w.to = point(w.to); return w; }
+  Shape operator()(Box b) const {
+    b.center = point(b.center);
+    b.rotation = rotation * b.rotation;
+    return b;
+  }
+  Shape operator()(Plate p) const {
+    p.origin = point(p.origin);
+    p.u_axis = rotation * p.u_axis;
+    p.v_axis = rotation * p.v_axis;
+    return p;
+  }
+  Shape operator()(Mesh m) const {
+    for (Vec3& v : m.mesh.vertices) v = point(v);
+    return m;
+  }
+};
+
+}  // namespace
+
 Shape transform_shape(const Shape& shape, const Mat3& rotation, const Vec3& translation) {
-  auto move = [&](const Vec3& p) { return Vec3(rotation * p + translation); };
-  struct Visitor {
-    const Mat3& rotation;
-    decltype(move)& move;
-    Shape operator()(Sphere s) const { s.center = move(s.center); return s; }
-    Shape operator()(Wire w) const { w.from = move(w.from); w.to = move(w.to); return w; }
-    Shape operator()(Box b) const { b.center = move(b.center); b.rotation = rotation * b.rotation; return b; }
-    Shape operator()(Plate p) const {
-      p.origin = move(p.origin);
-      p.u_axis = rotation * p.u_axis;
-      p.v_axis = rotation * p.v_axis;
-      return p;
-    }
-    Shape operator()(Mesh m) const {
-      for (Vec3& v : m.mesh.vertices) v = move(v);
-      return m;
-    }
-  };
-  return std::visit(Visitor{rotation, move}, shape);
+  return std::visit(RigidMotion{rotation, translation}, shape);
 }
 
 }  // namespace aloft::internal
