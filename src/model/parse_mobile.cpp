@@ -617,6 +617,7 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   Mesh m;
   const Path op = join(path, "obj");
   m.file = text(require(v, path, "obj", "the OBJ file's path, relative to this file"), op);
+  if (m.file.find('\0') != std::string::npos) fail(op, "must be a file path, got a string with a NUL character");
   Vec3 scale = Vec3::Ones(), translate = Vec3::Zero();
   if (const json* s = find(v, "scale")) {
     const Path sp = join(path, "scale");

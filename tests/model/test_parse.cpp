@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -496,7 +497,7 @@ TEST(Parse, FileErrorsNameTheFile) {
   }
 }
 
-TEST(Locator, PathsLinesAndColumns) {
+TEST(ParseLocator, PathsLinesAndColumns) {
   const std::string text =
       "{\n"
       "  \"name\": \"x\",\n"
@@ -540,7 +541,7 @@ TEST(Locator, PathsLinesAndColumns) {
   EXPECT_EQ(lc.column, 43);
 }
 
-TEST(Locator, LocateFallsBackToTheNearestAncestor) {
+TEST(ParseLocator, LocateFallsBackToTheNearestAncestor) {
   SourceMap map;
   map.places["components[2]"] = {"components[2]", 7, 5};
   map.places[""] = {"", 1, 1};
@@ -552,7 +553,7 @@ TEST(Locator, LocateFallsBackToTheNearestAncestor) {
   EXPECT_EQ(SourceMap{}.locate("x").line, 0);
 }
 
-TEST(Locator, DuplicateKeysInLargeObjects) {
+TEST(ParseLocator, DuplicateKeysInLargeObjects) {
   std::string text = "{";
   for (int i = 0; i < 100; ++i) text += "\"k" + std::to_string(i) + "\": " + std::to_string(i) + ",\n";
   text += "\"k42\": 0}";
@@ -566,7 +567,7 @@ TEST(Locator, DuplicateKeysInLargeObjects) {
 }
 
 // Arbitrary bytes never crash the locator or the parser, nor escape as anything but InputError.
-TEST(Locator, SurvivesArbitraryBytes) {
+TEST(ParseLocator, SurvivesArbitraryBytes) {
   std::mt19937 rng(12345);
   const std::string alphabet = "{}[]\",:\\ \n0123456789.eE-+truefalsnu\x80\xc3\xa9";
   const std::string valid = with_shape(R"({"sphere": {"center": [0, 1, 0], "radius": 0.1}})");
@@ -603,15 +604,21 @@ TEST(Parse, LargeMobileIsFast) {
             "{\"sphere\": {\"center\": [0.25, " + y + ", 0.125], \"radius\": 0.01}}]}";
   }
   text += "\n]}\n";
+  // Wall time for the record; the check is on processor time (all threads), which a loaded machine
+  // (tests run in parallel) does not inflate much.
   const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   const MobileSpec spec = parse_mobile_text(text, "big.json");
+  const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(spec.components.size(), static_cast<std::size_t>(kCount));
   EXPECT_EQ(spec.components.back().name, "c" + std::to_string(kCount - 1));
   EXPECT_EQ(spec.source.locate("components[65534].shapes[1].sphere.radius").line, 2 * kCount);
-  std::cout << "parsed " << text.size() / 1e6 << " MB, " << kCount << " components in " << seconds << " s\n";
-#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__) && !defined(__OPTIMIZE_SIZE__)
-  EXPECT_LT(seconds, 2.0);  // linear time: ~0.5 s on one core of a 2020s machine (the goal is < 1 s)
+  std::cout << "parsed " << text.size() / 1e6 << " MB, " << kCount << " components in " << seconds << " s ("
+            << cpu_seconds << " s of processor time)\n";
+#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__)
+  // ~0.5 s wall, ~0.8 s processor time on an idle machine; quadratic time would take minutes.
+  EXPECT_LT(cpu_seconds, 3.0);
 #endif
 }
 
@@ -640,7 +647,7 @@ std::vector<std::string> doc_examples() {
   return blocks;
 }
 
-TEST(MobileFormatDoc, ExamplesParseAndCompile) {
+TEST(ParseFormatDoc, ExamplesParseAndCompile) {
   const auto examples = doc_examples();
   ASSERT_GE(examples.size(), 1u);
   for (const auto& text : examples) {
@@ -661,7 +668,7 @@ std::set<std::string> set_of(const std::array<std::string_view, N>& a) {
   return {a.begin(), a.end()};
 }
 
-TEST(MobileFormatSchema, ListsExactlyTheKeysTheParserAccepts) {
+TEST(ParseFormatSchema, ListsExactlyTheKeysTheParserAccepts) {
   const auto schema = nlohmann::json::parse(read_text(fs::path(ALOFT_SOURCE_DIR) / "docs" / "mobile-format.schema.json"));
   EXPECT_EQ(schema.at("$schema"), "https://json-schema.org/draft/2020-12/schema");
   EXPECT_EQ(schema.at("additionalProperties"), false);
@@ -683,7 +690,7 @@ TEST(MobileFormatSchema, ListsExactlyTheKeysTheParserAccepts) {
 
 // With python3 and its jsonschema module: the documentation's examples and the fuzz seeds are valid
 // under the schema, and a file with an unknown key is not.
-TEST(MobileFormatSchema, ValidatesTheExamples) {
+TEST(ParseFormatSchema, ValidatesTheExamples) {
   if (std::system("python3 -c 'import jsonschema' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no python3 jsonschema";
   TempDir dir;
   const auto examples = doc_examples();
