@@ -63,8 +63,10 @@ struct Powers {
   }
 };
 
-// S(m, n) for one edge: sum_{i,j} weight * a0^(m-i) a1^i b0^(n-j) b1^j.
-inline double edge_sum(int m, int n, const Powers& a0, const Powers& a1, const Powers& b0, const Powers& b1) {
+// S(m, n) for one edge: sum_{i,j} weight * a0^(m-i) a1^i b0^(n-j) b1^j. The degrees are template
+// arguments so that the loops unroll over compile-time weights.
+template <int m, int n>
+inline double edge_sum(const Powers& a0, const Powers& a1, const Powers& b0, const Powers& b1) {
   double s = 0;
   for (int i = 0; i <= m; ++i) {
     double inner = 0;
@@ -82,16 +84,16 @@ struct ProjectionIntegrals {
     if (db == 0) return;  // every term carries d(beta)
     const Powers pa0(a0), pa1(a1), pb0(b0), pb1(b1);
     // Each accumulates db * S(p+1, q); the constant 1 / ((p+1)(p+q+2)) is applied in finish().
-    p1 += db * edge_sum(1, 0, pa0, pa1, pb0, pb1);
-    pa += db * edge_sum(2, 0, pa0, pa1, pb0, pb1);
-    pb += db * edge_sum(1, 1, pa0, pa1, pb0, pb1);
-    paa += db * edge_sum(3, 0, pa0, pa1, pb0, pb1);
-    pab += db * edge_sum(2, 1, pa0, pa1, pb0, pb1);
-    pbb += db * edge_sum(1, 2, pa0, pa1, pb0, pb1);
-    paaa += db * edge_sum(4, 0, pa0, pa1, pb0, pb1);
-    paab += db * edge_sum(3, 1, pa0, pa1, pb0, pb1);
-    pabb += db * edge_sum(2, 2, pa0, pa1, pb0, pb1);
-    pbbb += db * edge_sum(1, 3, pa0, pa1, pb0, pb1);
+    p1 += db * edge_sum<1, 0>(pa0, pa1, pb0, pb1);
+    pa += db * edge_sum<2, 0>(pa0, pa1, pb0, pb1);
+    pb += db * edge_sum<1, 1>(pa0, pa1, pb0, pb1);
+    paa += db * edge_sum<3, 0>(pa0, pa1, pb0, pb1);
+    pab += db * edge_sum<2, 1>(pa0, pa1, pb0, pb1);
+    pbb += db * edge_sum<1, 2>(pa0, pa1, pb0, pb1);
+    paaa += db * edge_sum<4, 0>(pa0, pa1, pb0, pb1);
+    paab += db * edge_sum<3, 1>(pa0, pa1, pb0, pb1);
+    pabb += db * edge_sum<2, 2>(pa0, pa1, pb0, pb1);
+    pbbb += db * edge_sum<1, 3>(pa0, pa1, pb0, pb1);
   }
 
   void finish() {
