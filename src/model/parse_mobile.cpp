@@ -17,6 +17,7 @@
 #include <fstream>
 #include <future>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <sstream>
 #include <string_view>
@@ -60,6 +61,14 @@ constexpr int kMaxNesting = 64;
 // ---------------------------------------------------------------------------------------------------
 // Parsing: nlohmann's DOM builder behind a SAX wrapper that remembers where a syntax error happened.
 
+// What nlohmann said about the first error, and where.
+struct SyntaxError {
+  std::size_t position = 0;  // characters read when it stopped, the offending one included
+  std::string token;         // the last token read, as nlohmann spells it
+  int id = 0;                // nlohmann's exception id: 101.. syntax, 406 number overflow
+  std::string message;       // nlohmann's what()
+};
+
 class DomBuilder {
  public:
   explicit DomBuilder(json& root) : dom_(root, false) {}
@@ -77,20 +86,12 @@ class DomBuilder {
   bool start_array(std::size_t n) { return dom_.start_array(n); }
   bool end_array() { return dom_.end_array(); }
 
-  bool parse_error(std::size_t position, const std::string& last_token, const nlohmann::detail::exception& ex) {
-    failed = true;
-    position_ = position;
-    last_token_ = last_token;
-    id_ = ex.id;
-    message_ = ex.what();
-    return false;
+  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& ex) {
+    error = SyntaxError{position, token, ex.id, ex.what()};
+    return false;  // stop
   }
 
-  bool failed = false;
-  std::size_t position_ = 0;  // nlohmann's count of characters read, the offending one included
-  std::string last_token_;
-  int id_ = 0;
-  std::string message_;
+  std::optional<SyntaxError> error;
 
  private:
   nlohmann::detail::json_sax_dom_parser<json> dom_;
@@ -118,26 +119,27 @@ json parse_json(const std::string& text, const std::string& file) {
   json root;
   DomBuilder builder(root);
   json::sax_parse(text, &builder, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/false);
-  if (!builder.failed) return root;
+  if (!builder.error) return root;
+  const SyntaxError& e = *builder.error;
 
-  const std::size_t offset = builder.position_ > 0 ? builder.position_ - 1 : 0;
-  if (builder.id_ == 406) {
+  // Where the offending token starts (nlohmann's token may hold more than the token: then use the
+  // last character read).
+  const std::size_t last = e.position > 0 ? e.position - 1 : 0;
+  const std::size_t start = e.token.size() <= e.position ? e.position - e.token.size() : last;
+  if (e.id == 406) {
     // A number too large for a double (1e999): nlohmann would make it infinite. Point at it by path.
-    const std::size_t start = builder.position_ >= builder.last_token_.size() ? builder.position_ - builder.last_token_.size() : 0;
     const auto at = internal::line_column_at(text, start);
     throw InputError(file, SourcePlace{internal::json_path_at(text, start), at.line, at.column},
-                     "must be a finite number, got " + builder.last_token_.substr(0, 40));
+                     "must be a finite number, got " + e.token.substr(0, 40));
   }
   // nlohmann reports the last character it read; for a whole token in the wrong place (`"a" "b"`),
   // point at the token's start instead.
-  std::size_t where = offset;
+  std::size_t where = last;
   for (const char* token : {"string", "number", "true", "false", "null"}) {
-    if (builder.message_.find("unexpected " + std::string(token) + " literal") != std::string::npos &&
-        builder.last_token_.size() <= builder.position_)
-      where = builder.position_ - builder.last_token_.size();
+    if (e.message.find("unexpected " + std::string(token) + " literal") != std::string::npos) where = start;
   }
   const auto at = internal::line_column_at(text, where);
-  throw InputError(file, SourcePlace{"", at.line, at.column}, plain_syntax_message(builder.message_));
+  throw InputError(file, SourcePlace{"", at.line, at.column}, plain_syntax_message(e.message));
 }
 
 // ---------------------------------------------------------------------------------------------------
