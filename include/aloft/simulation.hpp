@@ -10,6 +10,7 @@
 //   4. factor             children-first block LDL^T of the joint KKT matrix at the new pose, O(n)
 //   5. velocity projection  RATTLE: velocities projected (mass-weighted) onto the joints' tangent space
 //   6. check              stop with a report if any component's state is not finite
+// Where the joint impulses do not converge (a thin wire spinning fast), the step is halved, recursively.
 // Steps 2-5 are the constrained symplectic Euler method (Hairer, Lubich & Wanner, Geometric Numerical
 // Integration, VII.1): first order, symplectic for the translational part, so energy does not drift.
 
@@ -69,8 +70,12 @@ class Simulation {
 
   const std::optional<SimulationFailure>& failure() const { return failure_; }
   long long step_count() const { return steps_; }
+  // How many times a step had to be halved because the motion was too fast for it.
+  long long subdivisions() const;
 
  private:
+  bool rattle(double h);
+  bool advance_by(double h, int depth);
   void applied_wrenches(const State& state, std::vector<Eigen::Matrix<double, 6, 1>>& f) const;
 
   const Model& model_;

@@ -175,6 +175,14 @@ def steel_fish():
     l7, r7 = m.arm("O7 arm", "O5 arm", l5, 0.10, 0.14, 0.10, 120, 0.0015, black,
                    plate=(leaf(0.12, 0.08), 0.0015), plate_end="right")
     m.plate_leaf("O8 small fish", "O7 arm", l7, 0.07, fish(0.16, 0.07), 150, 0.0015, red)
+    # Densities "as built" (kg/m^3): close to the ones balance mode "mass" derives, so that in mode
+    # "none" the mobile hangs nearly balanced and swings gently; the ball (painted wood) and the small
+    # fish are a little off, as a maker's first cut would be.
+    densities = {"O1 top arm": 7850, "O2 arm": 3970, "O3 white leaf": 4880, "O6 arm": 1850,
+                 "O4 red ball": 410, "O5 arm": 2230, "O7 arm": 2100, "O8 small fish": 1500}
+    for c in m.doc["components"]:
+        if c["name"] in densities:
+            c["density"] = densities[c["name"]]
     m.write("steel-fish.json")
 
 
@@ -207,6 +215,13 @@ def southern_cross():
     l, r = m.arm("A7 arm", m.doc["components"][-1]["name"], joint, 0.08, 0.09, 0.11, 240, 0.0015, black)
     m.plate_leaf("D1 red disc", "A7 arm", l, 0.05, disc(0.04), 200, 0.002, red)
     m.plate_leaf("D2 black disc", "A7 arm", r, 0.06, disc(0.035), 280, 0.002, black)
+    # Densities as built (kg/m^3): the discs are thinner (lighter) down the chain, close to what balance
+    # mode "mass" derives; in mode "none" the red disc at the end is a little heavy, so it swings.
+    densities = {"A1 long arm": 7850, "A2 arm": 6635, "A3 arm": 4137, "A4 arm": 2641, "A5 arm": 1762,
+                 "A6 arm": 1127, "A7 arm": 980, "D1 red disc": 1060, "D2 black disc": 1003}
+    for c in m.doc["components"]:
+        if c["name"] in densities:
+            c["density"] = densities[c["name"]]
     m.write("southern-cross.json")
 
 

@@ -23,6 +23,12 @@ namespace {
 // joint impulses converges linearly at rate ~h|w|, so this costs 2-3 solves per step.
 constexpr double kJointTolerance = 1e-10;
 constexpr int kMaxJointIterations = 8;
+// A step whose joint impulses do not converge is split in two, recursively, at most this deep.
+constexpr int kMaxSubdivision = 8;
+// The largest turn (rad) of any component in one step. The drift's midpoint rotation is accurate to
+// O(turn^3); 0.05 rad keeps that below 1e-4 of the turn. A mobile swinging at a few rad/s turns ~0.005
+// rad per 1 ms step; a thin wire flung into a spin at hundreds of rad/s gets its step divided.
+constexpr double kMaxTurnPerStep = 0.05;
 
 }  // namespace
 
@@ -39,13 +45,16 @@ struct StepWorkspace {
         drift_map(model.count, Mat3::Identity()) {}
   TreeSolver solver;
   bool factored = false;         // solver holds the factorization at the current state's pose
-  State next;                    // the state being computed; swapped in when it is finite
+  State next;                    // the state being computed; swapped in when the step succeeds
+  State backup;                  // the state before a subdivided step, to return to if it fails
   std::vector<Vec6> wrench;      // scratch per body (force, torque), world
   std::vector<Vec3> rows;        // scratch per joint
   std::vector<Vec6> correction;  // solver output per body
   std::vector<Vec3> impulse;     // joint impulses of the last step (N s), for the warm start
   std::vector<Vec3> step_impulse;  // joint impulses being accumulated in this step
   std::vector<Mat3> drift_map;   // per body: kicked angular velocity -> drift angular velocity
+  double impulse_step = 0;       // the step length (s) the stored joint impulses belong to
+  long long subdivisions = 0;    // how many times a step was halved
 };
 
 namespace {
@@ -89,6 +98,8 @@ State& Simulation::mutable_state() {
   return state_;
 }
 
+long long Simulation::subdivisions() const { return work_->subdivisions; }
+
 void Simulation::set_timestep(double seconds) {
   timestep_ = seconds;
   std::fill(work_->impulse.begin(), work_->impulse.end(), Vec3::Zero());
@@ -107,9 +118,10 @@ void Simulation::applied_wrenches(const State& state, std::vector<Vec6>& f) cons
   }
 }
 
-bool Simulation::step() {
+// One RATTLE step of `h` seconds from state_ into work.next. Returns false, leaving state_ and the
+// factorization untouched, when the joint impulses do not converge (the motion is too fast for h).
+bool Simulation::rattle(double h) {
   const int n = model_.count;
-  const double h = timestep_;
   const std::vector<int>& parent = model_.parent;
   StepWorkspace& work = *work_;
   const State& now = state_;
@@ -127,22 +139,24 @@ bool Simulation::step() {
   // 1. Applied wrenches at the current state.
   applied_wrenches(now, f);
 
-  // 2. Half kick: applied impulses (h/2) f plus last step's joint impulses P (warm start), which act on
-  //    the child as (P, r x P) and on the parent as -(P, s x P).
+  // 2. Half kick: applied impulses (h/2) f plus last step's joint impulses P (warm start, scaled to
+  //    this step's length), which act on the child as (P, r x P) and on the parent as -(P, s x P).
+  const double warm = work.impulse_step > 0 ? h / work.impulse_step : 0.0;
+  for (int i = 1; i < n; ++i) work.step_impulse[i] = warm * work.impulse[i];
   for (int i = 1; i < n; ++i) {
+    const Vec3& impulse = work.step_impulse[i];
     f[i] *= 0.5 * h;
-    f[i].head<3>() += work.impulse[i];
-    f[i].tail<3>() += r[i].cross(work.impulse[i]);
+    f[i].head<3>() += impulse;
+    f[i].tail<3>() += r[i].cross(impulse);
     const int p = parent[i];
     if (p != 0) {
-      f[p].head<3>() -= work.impulse[i];
-      f[p].tail<3>() -= s[i].cross(work.impulse[i]);
+      f[p].head<3>() -= impulse;
+      f[p].tail<3>() -= s[i].cross(impulse);
     }
   }
   for (int i = 1; i < n; ++i) {
     next.velocity[i] = now.velocity[i] + f[i].head<3>() / model_.mass[i];
     next.angular[i] = now.angular[i] + inverse_inertia[i] * f[i].tail<3>();
-    work.step_impulse[i] = work.impulse[i];
   }
 
   // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
@@ -150,6 +164,9 @@ bool Simulation::step() {
   // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
   // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
   // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
+  double fastest = 0;
+  for (int i = 1; i < n; ++i) fastest = std::max(fastest, next.angular[i].squaredNorm());
+  if (!(h * std::sqrt(fastest) <= kMaxTurnPerStep)) return false;
   for (int i = 1; i < n; ++i) {
     const Quat half = (rotation_quaternion(0.5 * h * next.angular[i]) * now.orientation[i]).normalized();
     const Mat3 rot = half.toRotationMatrix();
@@ -160,6 +177,7 @@ bool Simulation::step() {
   // 3. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
   //    of the half kick so that every joint closes at the new pose (SHAKE). Newton's method with the
   //    current pose's factorization: solving J du = -C(x')/h moves the joints by -C to first order.
+  double previous_worst = INFINITY;
   for (int iteration = 0;; ++iteration) {
     double worst = 0;
     for (int i = 1; i < n; ++i) {
@@ -169,7 +187,8 @@ bool Simulation::step() {
     }
     for (int i = 1; i < n; ++i) {
       const Vec3 gap = joint_on_parent(model_, next, i) - joint_on_child(model_, next, i);
-      worst = std::max(worst, gap.cwiseAbs().maxCoeff());
+      const double g = gap.cwiseAbs().maxCoeff();
+      worst = g > worst || !std::isfinite(g) ? g : worst;  // a NaN gap stays NaN
       c[i] = gap / h;
     }
     if (!(worst > kJointTolerance) || iteration == kMaxJointIterations) { break; }
@@ -182,6 +201,7 @@ bool Simulation::step() {
     }
   }
   std::swap(work.impulse, work.step_impulse);
+  work.impulse_step = h;
 
   // 4. Factor at the new pose (also used by the next step). Angular velocities follow the new
   //    inertia at unchanged angular momentum: w' = I'^-1 I w.
@@ -205,32 +225,61 @@ bool Simulation::step() {
     next.angular[i] += du[i].tail<3>();
   }
   next.time = now.time + h;
-
-  // 6. Check: a non-finite state stops the simulation with a report; the last good state stays.
-  double sum = 0;
-  for (int i = 1; i < n; ++i)
-    sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() + next.orientation[i].w();
-  if (!std::isfinite(sum)) {
-    for (int i = 1; i < n; ++i) {
-      if (finite(next.position[i]) && finite(next.velocity[i]) && finite(next.angular[i]) &&
-          std::isfinite(next.orientation[i].w()))
-        continue;
-      SimulationFailure fail;
-      fail.component = i;
-      fail.component_name = model_.names[i];
-      fail.time = next.time;
-      std::ostringstream msg;
-      msg << "the simulation became non-finite at t = " << next.time << " s (step " << steps_ + 1
-          << "): component '" << model_.names[i] << "' has a NaN or infinite position, velocity or "
-          << "angular velocity; the last finite state is kept";
-      fail.message = msg.str();
-      failure_ = fail;
-      work.factored = false;  // the factorization is of the rejected pose
-      return false;
-    }
-  }
   std::swap(state_, next);
   work.factored = true;
+  return true;
+}
+
+// Advance by h, halving the step where RATTLE does not converge or turns a component too far (fast
+// spins, violent swings), down to h / 2^kMaxSubdivision.
+bool Simulation::advance_by(double h, int depth) {
+  if (rattle(h)) return true;
+  if (depth == kMaxSubdivision) return false;
+  if (depth == 0) work_->backup = state_;  // sized once: copying does not allocate after the first time
+  ++work_->subdivisions;
+  return advance_by(0.5 * h, depth + 1) && advance_by(0.5 * h, depth + 1);
+}
+
+bool Simulation::step() {
+  const double start = state_.time;
+  const long long subdivisions_before = work_->subdivisions;
+  const bool converged = advance_by(timestep_, 0);
+
+  // Check: a non-finite state (or one the solver cannot close) stops the simulation with a report.
+  const int n = model_.count;
+  double sum = 0;
+  for (int i = 1; i < n; ++i)
+    sum += state_.position[i].sum() + state_.velocity[i].sum() + state_.angular[i].sum() + state_.orientation[i].w();
+  if (!converged || !std::isfinite(sum)) {
+    int bad = 1;
+    for (int i = 1; i < n; ++i)
+      if (!(finite(state_.position[i]) && finite(state_.velocity[i]) && finite(state_.angular[i]) &&
+            std::isfinite(state_.orientation[i].w()))) {
+        bad = i;
+        break;
+      }
+    SimulationFailure fail;
+    fail.component = bad;
+    fail.component_name = model_.names[bad];
+    fail.time = start + timestep_;
+    std::ostringstream msg;
+    msg << "the simulation became non-finite at t = " << fail.time << " s (step " << steps_ + 1 << "): ";
+    if (std::isfinite(sum))
+      msg << "the joints could not be closed even with the step divided " << (1 << kMaxSubdivision)
+          << " times (near component '" << model_.names[bad] << "')";
+    else
+      msg << "component '" << model_.names[bad] << "' has a NaN or infinite position, velocity or angular velocity";
+    msg << "; the last finite state is kept";
+    fail.message = msg.str();
+    failure_ = fail;
+    if (work_->subdivisions == subdivisions_before) {
+      if (converged) std::swap(state_, work_->next);  // one whole step was taken: its start is in next
+    } else {
+      state_ = work_->backup;  // undo the completed substeps
+    }
+    work_->factored = false;
+    return false;
+  }
   ++steps_;
   return true;
 }
