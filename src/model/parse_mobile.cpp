@@ -350,7 +350,7 @@ class Reader {
 
   Vec3 nonzero_vec3(const json& v, const Path& path) const {
     const Vec3 x = vec3(v, path, "");
-    if (!(x.norm() > 0)) fail(path, "must be a non-zero vector [x, y, z]");
+    if (!(x.stableNorm() > 0)) fail(path, "must be a non-zero vector [x, y, z]");
     return x;
   }
 
@@ -546,7 +546,7 @@ Box Reader::box(const json& v, const Path& path) const {
     check_keys(*r, rp, format_keys::kRotation);
     const Vec3 axis = nonzero_vec3(require(*r, rp, "axis", "[x, y, z], a non-zero vector"), join(rp, "axis"));
     const double degrees = number(require(*r, rp, "degrees", "the angle in degrees"), join(rp, "degrees"), "degrees");
-    b.rotation = Eigen::AngleAxisd(degrees * std::numbers::pi / 180, axis.normalized()).toRotationMatrix();
+    b.rotation = Eigen::AngleAxisd(degrees * std::numbers::pi / 180, axis.stableNormalized()).toRotationMatrix();
   }
   return b;
 }
@@ -600,11 +600,12 @@ Plate Reader::plate(const json& v, const Path& path) const {
     p.origin = vec3(require(plane, lp, "origin", "[x, y, z] in m"), join(lp, "origin"), "m");
     const Vec3 u = nonzero_vec3(require(plane, lp, "u", "[x, y, z], the direction of the first coordinate"), join(lp, "u"));
     const Vec3 w = nonzero_vec3(require(plane, lp, "v", "[x, y, z], the direction of the second coordinate"), join(lp, "v"));
-    p.u_axis = u.normalized();
-    const Vec3 orthogonal = w - w.dot(p.u_axis) * p.u_axis;  // Gram-Schmidt
-    if (!(orthogonal.norm() > 1e-9 * w.norm()))
+    p.u_axis = u.stableNormalized();
+    Vec3 orthogonal = w - w.dot(p.u_axis) * p.u_axis;  // Gram-Schmidt
+    if (!(orthogonal.stableNorm() > 1e-9 * w.stableNorm()))
       fail(join(lp, "v"), "must not be parallel to \"u\" (they span the plate's plane)");
-    p.v_axis = orthogonal.normalized();
+    orthogonal = orthogonal.stableNormalized();
+    p.v_axis = (orthogonal - orthogonal.dot(p.u_axis) * p.u_axis).stableNormalized();  // twice is enough
   } else {
     fail(lp, "must be \"xy\", \"yz\", \"xz\" or {\"origin\", \"u\", \"v\"}, got " + describe(plane));
   }

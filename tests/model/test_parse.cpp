@@ -402,6 +402,23 @@ TEST(Parse, PlateParallelAxes) {
                "unknown key \"x\" (with \"plane\": \"xy\" the plane's offset is \"z\")");
 }
 
+TEST(Parse, PlateAxesAreOrthonormalEvenWhenNearlyParallelOrHuge) {
+  for (const std::string uv : {R"("u": [1, 0, 0], "v": [1, 1e-7, 0])", R"("u": [1e300, 1e300, 0], "v": [0, 0, 1e-300])"}) {
+    SCOPED_TRACE(uv);
+    const std::string text = with_shape(R"({"plate": {"thickness": 0.01, "points": [[0, 0], [1, 0], [0, 1]],
+          "plane": {"origin": [0, 1, 0], )" + uv + "}}}");
+    const auto plate = std::get<Plate>(parse_mobile_text(text).components[1].shapes[0].shape);
+    EXPECT_NEAR(plate.u_axis.norm(), 1, 1e-15);
+    EXPECT_NEAR(plate.v_axis.norm(), 1, 1e-15);
+    EXPECT_NEAR(plate.u_axis.dot(plate.v_axis), 0, 1e-15);
+  }
+  const std::string huge = with_shape(R"({"box": {"center": [0, 1, 0], "size": [1, 1, 1],
+          "rotation": {"axis": [1e300, 1e300, 0], "degrees": 30}}})");
+  const Mat3 r = std::get<Box>(parse_mobile_text(huge).components[1].shapes[0].shape).rotation;
+  EXPECT_TRUE((r.transpose() * r).isApprox(Mat3::Identity(), 1e-14));
+  EXPECT_TRUE((r * Vec3(1, 1, 0)).isApprox(Vec3(1, 1, 0), 1e-14));  // the axis stays put
+}
+
 TEST(Parse, MeshFileMissing) {
   TempDir dir;
   const std::string text = with_shape(R"({"mesh": {
