@@ -191,7 +191,11 @@ bool Simulation::rattle(double h) {
       worst = g > worst || !std::isfinite(g) ? g : worst;  // a NaN gap stays NaN
       c[i] = gap / h;
     }
-    if (!(worst > kJointTolerance) || iteration == kMaxJointIterations) { break; }
+    if (worst <= kJointTolerance) break;
+    // Not converging (too many iterations, growing or non-finite gaps): give up on this h.
+    if (iteration == kMaxJointIterations || !std::isfinite(worst) || (iteration >= 2 && !(worst < 0.5 * previous_worst)))
+      return false;
+    previous_worst = worst;
     for (int i = 1; i < n; ++i) f[i].setZero();
     solver.solve(f, c, du, &work.rows);  // rows now hold this iteration's joint impulses
     for (int i = 1; i < n; ++i) {
