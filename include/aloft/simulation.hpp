@@ -6,7 +6,7 @@
 //   1. applied forces     gravity, external loads (wind), air damping, implicit-midpoint gyroscopic torque
 //   2. predict            unconstrained velocities, warm-started with the last step's joint impulses
 //   3. joint impulses     SHAKE: Newton iterations on the joint impulses until the *new* positions
-//                         satisfy every joint (|C| < 1e-12 m), each iteration one O(n) tree solve
+//                         satisfy every joint (|C| < 1e-9 m), each iteration one O(n) tree solve
 //   4. factor             children-first block LDL^T of the joint KKT matrix at the new pose, O(n)
 //   5. velocity projection  RATTLE: velocities projected (mass-weighted) onto the joints' tangent space
 //   6. check              stop with a report if any component's state is not finite
