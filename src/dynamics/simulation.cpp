@@ -44,7 +44,10 @@ struct StepWorkspace {
         impulse(model.count, Vec3::Zero()),
         step_impulse(model.count, Vec3::Zero()),
         drift_map(model.count, Mat3::Identity()),
-        older_impulse(model.count, Vec3::Zero()) {}
+        older_impulse(model.count, Vec3::Zero()),
+        rotation(model.count, Mat3::Identity()) {
+    for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
+  }
   TreeSolver solver;
   bool factored = false;         // solver holds the factorization at the current state's pose
   State next;                    // the state being computed; swapped in when the step succeeds
@@ -58,6 +61,7 @@ struct StepWorkspace {
   std::vector<Vec3> older_impulse;  // joint impulses of the step before the last
   double impulse_step = 0;       // the step length (s) the stored joint impulses belong to
   double older_step = 0;         // and the one of older_impulse
+  std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
   long long subdivisions = 0;    // how many times a step was halved
 };
 
@@ -92,6 +96,7 @@ Simulation::Simulation(const Model& model, State initial)
       work_(std::make_unique<StepWorkspace>(model)) {
   loads_.resize(model.count);
   work_->next = state_;
+  work_->rotation[0] = state_.orientation[0].toRotationMatrix();
 }
 
 Simulation::~Simulation() = default;
@@ -115,9 +120,14 @@ void Simulation::applied_wrenches(const State& state, std::vector<Vec6>& f) cons
   const std::vector<Mat3>& inertia = work_->solver.world_inertia();
   for (int i = 1; i < model_.count; ++i) {
     const double m = model_.mass[i];
-    const Vec3& w = state.angular[i];
-    f[i].head<3>() = m * model_.gravity + loads_.force[i] - damping_.linear * m * state.velocity[i];
-    f[i].tail<3>() = loads_.torque[i] - damping_.angular * (inertia[i] * w);
+    f[i].head<3>() = m * model_.gravity + loads_.force[i];
+    f[i].tail<3>() = loads_.torque[i];
+  }
+  if (damping_.linear != 0 || damping_.angular != 0) {
+    for (int i = 1; i < model_.count; ++i) {
+      f[i].head<3>() -= damping_.linear * model_.mass[i] * state.velocity[i];
+      f[i].tail<3>() -= damping_.angular * (inertia[i] * state.angular[i]);
+    }
   }
 }
 
@@ -192,9 +202,12 @@ bool Simulation::rattle(double h) {
       next.position[i] = now.position[i] + h * next.velocity[i];
       next.orientation[i] =
           (rotation_quaternion(h * (work.drift_map[i] * next.angular[i])) * now.orientation[i]).normalized();
+      work.rotation[i] = next.orientation[i].toRotationMatrix();
     }
     for (int i = 1; i < n; ++i) {
-      const Vec3 gap = joint_on_parent(model_, next, i) - joint_on_child(model_, next, i);
+      const int p = parent[i];
+      const Vec3 gap = (next.position[p] + work.rotation[p] * model_.joint_in_parent[i]) -
+                       (next.position[i] + work.rotation[i] * model_.joint_in_child[i]);
       const double g = gap.cwiseAbs().maxCoeff();
       worst = g > worst || !std::isfinite(g) ? g : worst;  // a NaN gap stays NaN
       c[i] = gap / h;

@@ -32,7 +32,9 @@ TreeSolver::TreeSolver(const Model& model)
       block_b_(n_, Mat3::Zero()),
       block_c_(n_, Mat3::Zero()),
       has_children_(n_, 0),
-      d_inv_(n_, Mat6::Zero()),
+      a_inv_(n_, Mat3::Zero()),
+      t_(n_, Mat3::Zero()),
+      s_inv_(n_, Mat3::Zero()),
       w_(n_, Mat63::Zero()),
       k_inv_(n_, Mat3::Zero()),
       g_(n_, Vec6::Zero()),
@@ -54,29 +56,31 @@ void TreeSolver::factor(const State& state) {
     has_children_[i] = 0;
   }
 
-  // Tip to base: invert D_i, eliminate joint i, fold A^T K_i^-1 A (A = [E, -[s_i]x]) into the parent.
+  // Tip to base: factor D_i, eliminate joint i, fold A^T K_i^-1 A (A = [E, -[s_i]x]) into the parent.
   for (int i = n_ - 1; i >= 1; --i) {
-    Mat6& d_inv = d_inv_[i];
-    if (!has_children_[i]) {
-      // A leaf: D_i = M_i, so D_i^-1 = diag(E / m, I^-1).
-      d_inv.setZero();
-      d_inv.topLeftCorner<3, 3>().diagonal().setConstant(1.0 / model_.mass[i]);
-      d_inv.bottomRightCorner<3, 3>() = inverse_inertia_[i];
-    } else {
-      // D^-1 = [A^-1 + T S^-1 T^T, -T S^-1; -(T S^-1)^T, S^-1], T = A^-1 B, S = C - B^T T.
-      const Mat3 a_inv = block_a_[i].inverse();
-      const Mat3 t = a_inv * block_b_[i];
-      const Mat3 s_inv = (block_c_[i] - block_b_[i].transpose() * t).inverse();
-      const Mat3 t_s = t * s_inv;
-      d_inv.topLeftCorner<3, 3>() = a_inv + t_s * t.transpose();
-      d_inv.topRightCorner<3, 3>() = -t_s;
-      d_inv.bottomLeftCorner<3, 3>() = -t_s.transpose();
-      d_inv.bottomRightCorner<3, 3>() = s_inv;
-    }
-    // W_i = D_i^-1 J_ii^T with J_ii^T = [E; [r_i]x]; K_i = J_ii W_i = W_top - [r_i]x W_bottom.
     const Mat3 rx = skew(child_arm_[i]);
-    w_[i] = d_inv.leftCols<3>() + d_inv.rightCols<3>() * rx;
-    const Mat3 k = w_[i].topRows<3>() - rx * w_[i].bottomRows<3>();
+    Mat3 k;
+    if (!has_children_[i]) {
+      // A leaf: D_i = M_i = diag(m E, I), so W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
+      a_inv_[i] = Mat3::Identity() / model_.mass[i];
+      t_[i].setZero();
+      s_inv_[i] = inverse_inertia_[i];
+      const Mat3 w_bottom = inverse_inertia_[i] * rx;
+      w_[i].topRows<3>() = a_inv_[i];
+      w_[i].bottomRows<3>() = w_bottom;
+      k = a_inv_[i] - rx * w_bottom;
+    } else {
+      // W_i = D^-1 [E; [r]x]: with Z = [r]x - T^T, W_bottom = S^-1 Z, W_top = A^-1 - T W_bottom, and
+      // K_i = W_top - [r]x W_bottom = A^-1 + Z^T S^-1 Z.
+      a_inv_[i] = block_a_[i].inverse();
+      t_[i] = a_inv_[i] * block_b_[i];
+      s_inv_[i] = (block_c_[i] - block_b_[i].transpose() * t_[i]).inverse();
+      const Mat3 z = rx - t_[i].transpose();
+      const Mat3 w_bottom = s_inv_[i] * z;
+      w_[i].topRows<3>() = a_inv_[i] - t_[i] * w_bottom;
+      w_[i].bottomRows<3>() = w_bottom;
+      k = a_inv_[i] + z.transpose() * w_bottom;
+    }
     const Mat3 k_inv = k.inverse();
     k_inv_[i] = k_inv;
     const int p = parent[i];
@@ -99,7 +103,10 @@ void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, s
 
   // Tip to base: y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i), and g_p += J_ip^T a_i.
   for (int i = n_ - 1; i >= 1; --i) {
-    y_[i] = d_inv_[i] * g_[i];
+    const Vec3 g1 = g_[i].head<3>();
+    const Vec3 y2 = s_inv_[i] * (g_[i].tail<3>() - t_[i].transpose() * g1);
+    y_[i].head<3>() = a_inv_[i] * g1 - t_[i] * y2;
+    y_[i].tail<3>() = y2;
     const Vec3 r = child_arm_[i];
     const Vec3 j_y = y_[i].head<3>() + y_[i].tail<3>().cross(r);  // v + w x r
     a_[i] = k_inv_[i] * (c[i] - j_y);

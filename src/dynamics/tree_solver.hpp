@@ -61,7 +61,11 @@ class TreeSolver {
   std::vector<Mat3> block_b_;       // - sum K_c^-1 [s_c]x
   std::vector<Mat3> block_c_;       // I + sum -[s_c]x K_c^-1 [s_c]x       (symmetric)
   std::vector<char> has_children_;  // whether any joint was folded into the blocks
-  std::vector<Mat6> d_inv_;         // D_i^-1
+  // D_i^-1 in factored form: with T = A^-1 B and S = C - B^T T,
+  //   D^-1 [g1; g2] = [A^-1 g1 - T y2; y2],  y2 = S^-1 (g2 - T^T g1).
+  std::vector<Mat3> a_inv_;         // A^-1 (symmetric)
+  std::vector<Mat3> t_;             // T = A^-1 B (zero for a leaf)
+  std::vector<Mat3> s_inv_;         // S^-1 (symmetric)
   std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
   std::vector<Mat3> k_inv_;         // K_i^-1
   std::vector<Vec6> g_;             // solve scratch: condensed right-hand sides
