@@ -1,0 +1,165 @@
+// aloft_bench: the cost of a simulation step, and of the tree solver's factor and solve alone.
+//
+//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (bench_models.hpp): presets from
+//                        mobiles/ and generated mobiles of 15 ... 65535 components
+//   BM_Factor/<mobile>   TreeSolver::factor() at a swinging pose
+//   BM_Solve/<mobile>    TreeSolver::solve() with the factorization of that pose
+//
+// items_per_second is steps (or factorizations, solves) per second of CPU time; us_per_component_step is
+// the CPU time per moving component (count - 1) and per step, in microseconds. The mobiles start swinging
+// (bench_models.hpp: swinging_state), so that the joint iterations do real work.
+
+#include <benchmark/benchmark.h>
+#include <time.h>
+
+#include <cstdio>
+#include <exception>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "aloft/simulation.hpp"
+#include "bench_models.hpp"
+#include "dynamics/tree_solver.hpp"
+
+namespace {
+
+using aloft::Model;
+
+const std::vector<std::string> kPresets = {"steel-fish", "southern-cross"};
+const std::vector<int> kGenerated = {15, 127, 1023, 8191, 65535};
+
+// Models are built on first use (generating and compiling 65535 components takes a while) and kept.
+// A preset that is missing or does not load leaves an error message instead.
+struct Entry {
+  std::unique_ptr<Model> model;
+  std::string error;
+};
+
+const Entry& model_entry(const std::string& key) {
+  static std::map<std::string, Entry> cache;
+  auto found = cache.find(key);
+  if (found != cache.end()) return found->second;
+  Entry entry;
+  try {
+    if (key.rfind("generated-", 0) == 0) {
+      entry.model = aloft::bench::generated_model(std::stoi(key.substr(10)), 1);
+    } else if (!aloft::bench::preset_exists(key)) {
+      entry.error = "no preset " + aloft::bench::preset_path(key);
+    } else {
+      entry.model = aloft::bench::preset_model(key);
+    }
+  } catch (const std::exception& e) {
+    entry.error = key + ": " + e.what();
+  }
+  return cache.emplace(key, std::move(entry)).first->second;
+}
+
+// Thread CPU time (s), as the benchmark's CPU column measures a single-threaded run.
+double cpu_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// items_per_second = steps per second; us_per_component_step from the CPU time of the timed loop
+// (cpu_seconds: seconds spent in the loop, measured by the caller around it).
+void set_counters(benchmark::State& state, const Model& model, double loop_seconds) {
+  state.SetItemsProcessed(state.iterations());
+  state.counters["components"] = model.count;
+  if (state.iterations() > 0)
+    state.counters["us_per_component_step"] =
+        loop_seconds * 1e6 / (static_cast<double>(state.iterations()) * (model.count - 1));
+}
+
+void BM_Step(benchmark::State& state, const std::string& key) {
+  const Entry& entry = model_entry(key);
+  if (!entry.model) {
+    state.SkipWithError(entry.error.c_str());
+    for (auto _ : state) {}
+    return;
+  }
+  const Model& model = *entry.model;
+  aloft::Simulation sim(model, aloft::bench::swinging_state(model));
+  const double start = cpu_seconds();
+  for (auto _ : state) {
+    if (!sim.step()) {
+      state.SkipWithError(sim.failure()->message.c_str());
+      break;
+    }
+  }
+  const double elapsed = cpu_seconds() - start;
+  benchmark::DoNotOptimize(sim.state().position.data());
+  set_counters(state, model, elapsed);
+}
+
+void BM_Factor(benchmark::State& state, const std::string& key) {
+  const Entry& entry = model_entry(key);
+  if (!entry.model) {
+    state.SkipWithError(entry.error.c_str());
+    for (auto _ : state) {}
+    return;
+  }
+  const Model& model = *entry.model;
+  const aloft::State pose = aloft::bench::swinging_state(model);
+  aloft::TreeSolver solver(model);
+  const double start = cpu_seconds();
+  for (auto _ : state) {
+    solver.factor(pose);
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model, cpu_seconds() - start);
+}
+
+void BM_Solve(benchmark::State& state, const std::string& key) {
+  const Entry& entry = model_entry(key);
+  if (!entry.model) {
+    state.SkipWithError(entry.error.c_str());
+    for (auto _ : state) {}
+    return;
+  }
+  const Model& model = *entry.model;
+  const aloft::State pose = aloft::bench::swinging_state(model);
+  aloft::TreeSolver solver(model);
+  solver.factor(pose);
+  // Right-hand side: gravity on every body, a small gap at every joint.
+  std::vector<aloft::Vec6> f(model.count, aloft::Vec6::Zero());
+  std::vector<aloft::Vec3> c(model.count, aloft::Vec3::Zero());
+  for (int i = 1; i < model.count; ++i) {
+    f[i].head<3>() = model.mass[i] * model.gravity;
+    c[i] = aloft::Vec3(1e-6, -2e-6, 3e-6);
+  }
+  std::vector<aloft::Vec6> u(model.count, aloft::Vec6::Zero());
+  std::vector<aloft::Vec3> lambda(model.count, aloft::Vec3::Zero());
+  const double start = cpu_seconds();
+  for (auto _ : state) {
+    solver.solve(f, c, u, &lambda);
+    benchmark::DoNotOptimize(u.data());
+    benchmark::DoNotOptimize(lambda.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model, cpu_seconds() - start);
+}
+
+void register_all() {
+  std::vector<std::string> keys = kPresets;
+  for (int n : kGenerated) keys.push_back("generated-" + std::to_string(n));
+  for (const std::string& key : keys)
+    benchmark::RegisterBenchmark(("BM_Step/" + key).c_str(), BM_Step, key)->Unit(benchmark::kMicrosecond);
+  for (const std::string& key : keys)
+    benchmark::RegisterBenchmark(("BM_Factor/" + key).c_str(), BM_Factor, key)->Unit(benchmark::kMicrosecond);
+  for (const std::string& key : keys)
+    benchmark::RegisterBenchmark(("BM_Solve/" + key).c_str(), BM_Solve, key)->Unit(benchmark::kMicrosecond);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_all();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,31 @@
+#include <stdexcept>
+
+#include "aloft/simulation.hpp"
+#include "compare/engine.hpp"
+
+namespace aloft::compare {
+namespace {
+
+class AloftEngine : public Engine {
+ public:
+  AloftEngine(const Model& model, const State& initial, double timestep) : sim_(model, initial) {
+    sim_.set_timestep(timestep);
+    sim_.set_damping(DampingSpec{});
+  }
+  std::string name() const override { return "Aloft"; }
+  void step() override {
+    if (!sim_.step()) throw std::runtime_error("Aloft: " + sim_.failure()->message);
+  }
+  void read(State& out) override { out = sim_.state(); }
+
+ private:
+  Simulation sim_;
+};
+
+}  // namespace
+
+std::unique_ptr<Engine> make_aloft(const Model& model, const State& initial, double timestep) {
+  return std::make_unique<AloftEngine>(model, initial, timestep);
+}
+
+}  // namespace aloft::compare
