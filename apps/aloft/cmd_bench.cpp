@@ -1,0 +1,185 @@
+// aloft bench: simulation speed (steps per second) on the preset mobiles and on generated mobiles of
+// growing size. Each mobile is set swinging by a short gust, then timed over 5 repetitions of enough steps
+// for at least 0.5 s each (or --steps); the median is reported.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "aloft/generate.hpp"
+#include "aloft/model.hpp"
+#include "aloft/simulation.hpp"
+#include "common.hpp"
+
+#ifndef ALOFT_BUILD_TYPE
+#define ALOFT_BUILD_TYPE "unknown"
+#endif
+
+namespace aloft::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0 || line.rfind("Model", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) {
+        std::string s = line.substr(colon + 1);
+        s.erase(0, s.find_first_not_of(" \t"));
+        if (!s.empty()) return s;
+      }
+    }
+  }
+  return "unknown CPU";
+}
+
+struct Measurement {
+  double steps_per_second = 0;
+  long long steps_per_repetition = 0;
+  std::string failure;  // non-empty if the simulation failed
+};
+
+Measurement measure(const Model& model, long long fixed_steps) {
+  constexpr int kRepetitions = 5;
+  Measurement out;
+  Simulation sim(model);
+  // Warm up with a gust: a horizontal push on every component, turning with the index, so that the mobile
+  // swings (a balanced mobile at rest would be an unrepresentatively easy case).
+  sim.loads().resize(model.count);
+  for (int i = 1; i < model.count; ++i) {
+    const double a = 2.399963 * i;  // golden angle
+    sim.loads().force[i] = 1.5 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+  }
+  const auto warm_start = Clock::now();
+  long long warm_steps = 0;
+  while (warm_steps < 3 || (warm_steps < 300 && seconds_since(warm_start) < 0.3)) {
+    if (!sim.step()) {
+      out.failure = sim.failure() ? sim.failure()->message : "the simulation failed";
+      return out;
+    }
+    ++warm_steps;
+  }
+  sim.loads().clear();
+  const double warm_rate = static_cast<double>(warm_steps) / std::max(seconds_since(warm_start), 1e-9);
+  out.steps_per_repetition =
+      fixed_steps > 0 ? fixed_steps : std::max(3LL, static_cast<long long>(std::ceil(0.5 * warm_rate)));
+
+  std::vector<double> rates;
+  for (int r = 0; r < kRepetitions; ++r) {
+    const auto start = Clock::now();
+    for (long long s = 0; s < out.steps_per_repetition; ++s) {
+      if (!sim.step()) {
+        out.failure = sim.failure() ? sim.failure()->message : "the simulation failed";
+        return out;
+      }
+    }
+    const double elapsed = std::max(seconds_since(start), 1e-9);
+    rates.push_back(static_cast<double>(out.steps_per_repetition) / elapsed);
+    // Keep a too-short calibration from making the repetitions short: re-measure at >= 0.5 s.
+    if (r == 0 && fixed_steps <= 0 && elapsed < 0.4) {
+      out.steps_per_repetition = std::max(3LL, static_cast<long long>(std::ceil(0.5 * rates.back())));
+      rates.clear();
+      r = -1;
+    }
+  }
+  std::sort(rates.begin(), rates.end());
+  out.steps_per_second = rates[rates.size() / 2];
+  return out;
+}
+
+void print_row(const std::string& name, int components, const Measurement& m) {
+  if (!m.failure.empty()) {
+    std::printf("%-28s %10d  failed: %s\n", name.c_str(), components, m.failure.c_str());
+  } else {
+    const double us = 1e6 / m.steps_per_second;
+    std::printf("%-28s %10d %12.1f %12.2f %14.4f\n", name.c_str(), components, m.steps_per_second, us,
+                us / std::max(1, components - 1));
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+Runner add_bench(CLI::App& app) {
+  struct Options {
+    long long steps = 0;
+    std::vector<int> sizes{15, 127, 1023, 8191, 65535};
+    std::string presets;
+  };
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "bench",
+      "Measure simulation speed on the preset mobiles and on generated ones");
+  sub->add_option("--steps", o->steps, "Steps per repetition (>= 1; default: enough for 0.5 s)")
+      ->type_name("N")
+      ->check(integer_in(1, 1000000000));
+  sub->add_option("--sizes", o->sizes, "Sizes (components, hook included) of the generated mobiles, comma-separated (each >= 2; default 15,127,1023,8191,65535)")
+      ->type_name("N,...")
+      ->delimiter(',')
+      ->check(integer_in(2, 1 << 24));
+  sub->add_option("--presets", o->presets, "Directory of the preset mobiles (default: the source tree's mobiles/)")
+      ->type_name("DIR");
+  sub->footer(
+      "Prints steps per second, microseconds per step and per moving component per step for the preset\n"
+      "mobiles (steel-fish.json and southern-cross.json; a missing one is skipped with a note) and for\n"
+      "generated mobiles (seed 1). Each mobile is set swinging by a short gust, then timed over 5\n"
+      "repetitions of at least 0.5 s (or --steps steps); the median is reported.\n"
+      "\n"
+      "Examples:\n"
+      "  aloft bench\n"
+      "  aloft bench --sizes 15,127 --steps 2000\n"
+      "  aloft bench --presets ~/aloft/mobiles --sizes 1023\n");
+  return [o] {
+    namespace fs = std::filesystem;
+    const std::string dir = o->presets.empty() ? (fs::path(source_dir()) / "mobiles").string() : o->presets;
+    std::printf("aloft bench: %s, %u cores; build %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
+                ALOFT_BUILD_TYPE);
+    std::printf("median of 5 repetitions of %s, after a warm-up with a gust\n\n",
+                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s");
+    std::printf("%-28s %10s %12s %12s %14s\n", "mobile", "components", "steps/s", "us/step", "us/comp/step");
+    std::fflush(stdout);
+    std::vector<std::string> notes;
+    for (const char* preset : {"steel-fish.json", "southern-cross.json"}) {
+      const fs::path path = fs::path(dir) / preset;
+      std::error_code ec;
+      if (!fs::is_regular_file(path, ec)) {
+        notes.push_back(std::string(preset) + " skipped: " + path.string() + " not found");
+        continue;
+      }
+      try {
+        const Model model = load_mobile(path.string());
+        print_row(preset, model.count, measure(model, o->steps));
+      } catch (const std::exception& e) {
+        notes.push_back(std::string(preset) + " skipped: " + e.what());
+      }
+    }
+    for (int n : o->sizes) {
+      GenerateOptions g;
+      g.components = n;
+      g.seed = 1;
+      const Model model = compile(parse_mobile_text(generate_mobile(g), format("generated-%d.json", n)));
+      print_row(format("generated (seed 1)"), n, measure(model, o->steps));
+    }
+    if (!notes.empty()) {
+      std::printf("\n");
+      for (const std::string& n : notes) std::printf("note: %s\n", n.c_str());
+    }
+    return kExitOk;
+  };
+}
+
+}  // namespace aloft::cli

@@ -1,0 +1,243 @@
+// aloft simulate: a headless run from the designed pose at rest, with an optional trajectory CSV and a
+// summary (speed, energy drift, joint separation).
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "aloft/model.hpp"
+#include "aloft/simulation.hpp"
+#include "common.hpp"
+
+namespace aloft::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The trajectory CSV, written frame by frame through a large buffer.
+class Trajectory {
+ public:
+  Trajectory(const std::string& path, const Model& model) : path_(path) {
+    file_ = std::fopen(path.c_str(), "wb");
+    if (!file_) throw Failure("cannot write " + path + ": " + std::strerror(errno));
+    names_.reserve(model.names.size());
+    for (const std::string& n : model.names) names_.push_back(csv_field(n));
+    buffer_ = "t,component,x,y,z,qw,qx,qy,qz\n";
+  }
+  ~Trajectory() {
+    if (file_) std::fclose(file_);
+  }
+  Trajectory(const Trajectory&) = delete;
+  Trajectory& operator=(const Trajectory&) = delete;
+
+  void frame(const State& s) {
+    std::string t;
+    append_double(t, s.time);
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+      buffer_ += t;
+      buffer_ += ',';
+      buffer_ += names_[i];
+      const Vec3& p = s.position[i];
+      const Quat& q = s.orientation[i];
+      for (double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}) {
+        buffer_ += ',';
+        append_double(buffer_, v);
+      }
+      buffer_ += '\n';
+    }
+    if (buffer_.size() > (1u << 22)) flush();
+  }
+
+  void close() {
+    flush();
+    const int failed = std::fclose(file_);
+    file_ = nullptr;
+    if (failed != 0) throw Failure("cannot write " + path_ + ": " + std::strerror(errno));
+  }
+
+ private:
+  void flush() {
+    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+      throw Failure("cannot write " + path_ + ": " + std::strerror(errno));
+    buffer_.clear();
+  }
+
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  std::vector<std::string> names_;
+  std::string buffer_;
+};
+
+// A progress line on stderr for runs longer than about 2 s: rewritten in place a few times a second on a
+// terminal, otherwise one line per 10 %.
+class Progress {
+ public:
+  Progress(bool enabled, long long total) : enabled_(enabled), total_(total), tty_(is_terminal(stderr)) {}
+
+  void update(long long done, double sim_time) {
+    if (!enabled_ || total_ <= 0) return;
+    const double elapsed = seconds_since(start_);
+    if (elapsed < 2.0) return;
+    const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+    if (tty_) {
+      if (elapsed - last_ < 0.25) return;
+      last_ = elapsed;
+      const double rate = static_cast<double>(done) / elapsed;
+      const double left = rate > 0 ? static_cast<double>(total_ - done) / rate : 0;
+      std::fprintf(stderr, "\r  simulating: %3.0f%%  t = %.3f s  %.0f steps/s  %.0f s left   ", fraction * 100,
+                   sim_time, rate, left);
+      std::fflush(stderr);
+      shown_ = true;
+    } else {
+      const int decile = static_cast<int>(fraction * 10);
+      if (decile <= decile_) return;
+      decile_ = decile;
+      std::fprintf(stderr, "aloft: simulating: %d%% (t = %.3f s, %.0f s elapsed)\n", decile * 10, sim_time, elapsed);
+    }
+  }
+
+  void finish() {
+    if (shown_) std::fprintf(stderr, "\r%*s\r", 72, "");
+    shown_ = false;
+  }
+
+ private:
+  bool enabled_;
+  long long total_;
+  bool tty_;
+  Clock::time_point start_ = Clock::now();
+  double last_ = -1;
+  int decile_ = 0;
+  bool shown_ = false;
+};
+
+}  // namespace
+
+Runner add_simulate(CLI::App& app) {
+  struct Options {
+    std::string file;
+    double duration = 0;
+    double dt = 0;  // 0: the mobile's timestep
+    int every = 10;
+    std::string out;
+    bool damping_off = false;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "simulate",
+      "Simulate a mobile without a window and write its trajectory");
+  sub->add_option("file", o->file, "The mobile file (JSON)")->type_name("FILE")->required();
+  sub->add_option("-t,--duration", o->duration, "Simulated time (s, > 0)")
+      ->type_name("T")
+      ->required()
+      ->check(positive_number());
+  sub->add_option("--dt", o->dt, "Time step (s, > 0 and <= 0.01); default: the mobile's \"timestep\" (0.001 unless set)")
+      ->type_name("H")
+      ->check(timestep_range());
+  sub->add_option("-k,--every", o->every, "Write a trajectory frame every K steps (>= 1)")
+      ->type_name("K")
+      ->capture_default_str()
+      ->check(integer_in(1, 1000000000));
+  sub->add_option("-o,--out", o->out, "Trajectory CSV file (default: none)")->type_name("FILE");
+  sub->add_flag("--damping-off", o->damping_off, "Switch off the mobile's air damping");
+  sub->add_flag("-q,--quiet", o->quiet, "Print neither progress nor the summary");
+  sub->footer(
+      "Starts from the designed pose at rest and prints a summary: steps, simulated and wall time, speed,\n"
+      "energy drift and the largest joint separation seen. With --out, also writes the trajectory as CSV:\n"
+      "header t,component,x,y,z,qw,qx,qy,qz, one row per component (by name) per output frame, a frame\n"
+      "every --every steps with t = 0 included; x,y,z is the centre of mass and qw,qx,qy,qz the orientation\n"
+      "of the component's principal frame (as 'aloft inspect' rest_orientation), world frame, SI units.\n"
+      "\n"
+      "Examples:\n"
+      "  aloft simulate mobiles/steel-fish.json --duration 10\n"
+      "  aloft simulate random.json --duration 2 --dt 0.0005 --every 20 --out trajectory.csv\n"
+      "  aloft simulate random.json -t 60 --damping-off        # check energy conservation\n"
+      "\n"
+      "Exit code 3 if the simulation fails (its state stops being finite); the CSV then holds the\n"
+      "frames computed until then.\n");
+  return [o] {
+    const Model model = load_mobile(o->file);
+    Simulation sim(model);
+    if (o->dt > 0) sim.set_timestep(o->dt);
+    if (o->damping_off) sim.set_damping(DampingSpec{});
+    const double h = sim.timestep();
+    const long long steps = std::max(1LL, static_cast<long long>(std::ceil(o->duration / h - 1e-9)));
+
+    std::unique_ptr<Trajectory> csv;
+    if (!o->out.empty()) csv = std::make_unique<Trajectory>(o->out, model);
+
+    const State rest = rest_state(model);
+    const double e_rest = potential_energy(model, rest);
+    const double e0 = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+    double worst_separation = max_joint_separation(model, sim.state());
+    double peak_kinetic = 0;
+    if (csv) csv->frame(sim.state());
+
+    Progress progress(!o->quiet, steps);
+    const auto start = Clock::now();
+    bool ok = true;
+    long long done = 0;
+    while (done < steps) {
+      if (!sim.step()) {
+        ok = false;
+        break;
+      }
+      ++done;
+      if (done % o->every == 0) {
+        const State& s = sim.state();
+        if (csv) csv->frame(s);
+        worst_separation = std::max(worst_separation, max_joint_separation(model, s));
+        peak_kinetic = std::max(peak_kinetic, kinetic_energy(model, s));
+      }
+      if ((done & 63) == 0) progress.update(done, sim.state().time);
+    }
+    const double wall = seconds_since(start);
+    progress.finish();
+    if (csv) csv->close();
+    if (!ok) {
+      print_error(sim.failure() ? sim.failure()->message : "the simulation failed");
+      return kExitSimulation;
+    }
+
+    if (!o->quiet) {
+      const State& s = sim.state();
+      worst_separation = std::max(worst_separation, max_joint_separation(model, s));
+      const double e1 = kinetic_energy(model, s) + potential_energy(model, s);
+      const double drift = e1 - e0;
+      const double swing = std::abs(e0 - e_rest);
+      std::string energy = format("%.3e J", drift);
+      if (swing > 1e-12 * std::max(1.0, std::abs(e_rest)))
+        energy += format(" (%.3g %% of the initial swing energy %.3e J)", 100 * drift / swing, swing);
+      else if (peak_kinetic > 1e-12)
+        energy += format(" (%.3g %% of the largest kinetic energy seen, %.3e J)", 100 * drift / peak_kinetic,
+                         peak_kinetic);
+      if (!o->damping_off && (model.damping.linear > 0 || model.damping.angular > 0))
+        energy += "; damping is on (--damping-off to check conservation)";
+      std::printf("mobile            %s\n", model.name.c_str());
+      std::printf("components        %d\n", model.count);
+      std::printf("steps             %lld of %g s\n", done, h);
+      std::printf("simulated time    %.6g s\n", s.time);
+      std::printf("wall time         %.3f s\n", wall);
+      std::printf("speed             %.0f steps/s (%.3g x real time)\n", wall > 0 ? done / wall : 0.0,
+                  wall > 0 ? s.time / wall : 0.0);
+      std::printf("energy drift      %s\n", energy.c_str());
+      std::printf("joint separation  %.3e m (largest seen)\n", worst_separation);
+      if (csv)
+        std::printf("trajectory        %s (%lld frames x %d components)\n", o->out.c_str(), done / o->every + 1,
+                    model.count);
+      std::fflush(stdout);
+    }
+    return kExitOk;
+  };
+}
+
+}  // namespace aloft::cli

@@ -1,0 +1,172 @@
+#include "common.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdarg>
+#include <cstring>
+#include <vector>
+
+namespace aloft::cli {
+
+void print_error(const std::string& message) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "aloft: error: %s\n", message.c_str());
+}
+
+void append_double(std::string& out, double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, result.ptr);
+}
+
+std::string format_double(double value) {
+  std::string s;
+  append_double(s, value);
+  return s;
+}
+
+std::string format(const char* fmt, ...) {
+  std::va_list args;
+  va_start(args, fmt);
+  std::va_list copy;
+  va_copy(copy, args);
+  const int n = std::vsnprintf(nullptr, 0, fmt, copy);
+  va_end(copy);
+  std::string s(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
+  if (n > 0) std::vsnprintf(s.data(), s.size() + 1, fmt, args);
+  va_end(args);
+  return s;
+}
+
+std::string fixed(double value, int decimals) {
+  std::string s = format("%.*f", decimals, value);
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  return s;
+}
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  out += '"';
+  return out;
+}
+
+bool is_terminal(std::FILE* stream) { return ::isatty(::fileno(stream)) == 1; }
+
+void write_file(const std::string& path, const std::string& text) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw Failure("cannot write " + path + ": " + std::strerror(errno));
+  const std::size_t written = std::fwrite(text.data(), 1, text.size(), f);
+  const int err = written == text.size() ? 0 : errno;
+  if (std::fclose(f) != 0 || written != text.size())
+    throw Failure("cannot write " + path + ": " + std::strerror(err ? err : EIO));
+}
+
+std::string source_dir() {
+#ifdef ALOFT_SOURCE_DIR
+  return ALOFT_SOURCE_DIR;
+#else
+  return ".";
+#endif
+}
+
+CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        double v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(input, &used);
+          if (used != input.size()) return "must be a number, got \"" + input + "\"";
+        } catch (const std::exception&) {
+          return "must be a number, got \"" + input + "\"";
+        }
+        if (!(v > 0) || !std::isfinite(v)) return "must be a positive number, got " + input;
+        return {};
+      },
+      "");
+}
+
+CLI::Validator integer_in(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& input) -> std::string {
+        long long v = 0;
+        const char* end = input.data() + input.size();
+        const auto [ptr, ec] = std::from_chars(input.data(), end, v);
+        if (ec != std::errc() || ptr != end || v < lo || v > hi)
+          return "must be an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got \"" +
+                 input + "\"";
+        return {};
+      },
+      "");
+}
+
+CLI::Validator timestep_range() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        double v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(input, &used);
+          if (used != input.size()) return "must be a number of seconds, got \"" + input + "\"";
+        } catch (const std::exception&) {
+          return "must be a number of seconds, got \"" + input + "\"";
+        }
+        if (!(v > 0 && v <= 0.01)) return "must be greater than 0 and at most 0.01 s, got " + input;
+        return {};
+      },
+      "");
+}
+
+}  // namespace aloft::cli
+
+namespace aloft::cli {
+
+namespace {
+// Display width of UTF-8 text: the number of code points (no wide characters are used here).
+std::size_t display_width(const std::string& s) {
+  std::size_t n = 0;
+  for (unsigned char c : s)
+    if ((c & 0xC0) != 0x80) ++n;
+  return n;
+}
+}  // namespace
+
+Table::Table(std::vector<std::string> header, std::vector<bool> right_aligned) : right_(std::move(right_aligned)) {
+  right_.resize(header.size(), false);
+  rows_.push_back(std::move(header));
+}
+
+void Table::add(std::vector<std::string> row) {
+  row.resize(rows_.front().size());
+  rows_.push_back(std::move(row));
+}
+
+std::string Table::str(const std::string& indent) const {
+  const std::size_t columns = rows_.front().size();
+  std::vector<std::size_t> width(columns, 0);
+  for (const auto& row : rows_)
+    for (std::size_t c = 0; c < columns; ++c) width[c] = std::max(width[c], display_width(row[c]));
+  std::string out;
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    std::string line = indent;
+    for (std::size_t c = 0; c < columns; ++c) {
+      const std::string& cell = rows_[r][c];
+      const std::string pad(width[c] - display_width(cell), ' ');
+      if (c) line += "  ";
+      line += right_[c] ? pad + cell : cell + (c + 1 < columns ? pad : "");
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace aloft::cli

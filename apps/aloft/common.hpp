@@ -1,0 +1,84 @@
+#pragma once
+// Shared pieces of the `aloft` command line: subcommand registration, errors, number formatting, CSV
+// quoting, terminal detection.
+
+#include <cstdio>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace aloft::cli {
+
+// Exit codes.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInput = 1;       // bad input file, unwritable output, ...
+inline constexpr int kExitUsage = 2;       // wrong command line
+inline constexpr int kExitSimulation = 3;  // the simulation failed (state not finite)
+
+// A problem that is not in an input file (unwritable output, a directory that does not exist): printed as
+// "aloft: error: <what>" with exit code 1, like an InputError.
+class Failure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A subcommand's body, run after the command line was parsed; returns the exit code.
+using Runner = std::function<int()>;
+
+// Each subcommand adds itself to `app` and returns what runs it.
+Runner add_generate(CLI::App& app);
+Runner add_inspect(CLI::App& app);
+Runner add_simulate(CLI::App& app);
+Runner add_bench(CLI::App& app);
+
+// "aloft: error: <message>" on stderr.
+void print_error(const std::string& message);
+
+// Shortest text that reads back as the same double (std::to_chars), e.g. "0.1", "1e-07".
+std::string format_double(double value);
+// Appends the same to `out`.
+void append_double(std::string& out, double value);
+
+// printf-style formatting into a std::string.
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+
+// A number with `decimals` digits after the point, without a minus sign on zero ("-0.000").
+std::string fixed(double value, int decimals);
+
+// A CSV field per RFC 4180: quoted (with doubled quotes) if it holds a comma, quote, CR or LF.
+std::string csv_field(const std::string& text);
+
+// Whether the stream is an interactive terminal.
+bool is_terminal(std::FILE* stream);
+
+// A whole file written at once, or a Failure naming it.
+void write_file(const std::string& path, const std::string& text);
+
+// Directory of the source tree this program was built from (for the preset mobiles).
+std::string source_dir();
+
+// Validators with clear messages.
+CLI::Validator positive_number();          // > 0
+CLI::Validator timestep_range();           // (0, 0.01]
+CLI::Validator integer_in(long long lo, long long hi);  // an integer in [lo, hi]
+
+}  // namespace aloft::cli
+
+namespace aloft::cli {
+
+// A plain text table: columns padded to their widest cell, numbers right-aligned.
+class Table {
+ public:
+  explicit Table(std::vector<std::string> header, std::vector<bool> right_aligned = {});
+  void add(std::vector<std::string> row);
+  std::string str(const std::string& indent = "") const;
+
+ private:
+  std::vector<std::vector<std::string>> rows_;
+  std::vector<bool> right_;
+};
+
+}  // namespace aloft::cli

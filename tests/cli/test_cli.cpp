@@ -1,0 +1,256 @@
+// The `aloft` command line, run as a program (ALOFT_CLI): generate, inspect --json, simulate's CSV, error
+// messages and exit codes, --help and --version.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "aloft/model.hpp"
+
+namespace aloft {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("aloft-cli-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `aloft <args>` (args already shell-quoted where needed) in the temporary directory.
+  Result aloft(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = "cd " + quote(dir_.string()) + " && " + quote(ALOFT_CLI) + " " + args + " >" +
+                                quote(out.string()) + " 2>" + quote(err.string()) + " </dev/null";
+    const int status = std::system(command.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = read(out);
+    r.err = read(err);
+    return r;
+  }
+
+  fs::path dir_;
+};
+
+// The small mobile of docs/mobile-format.md, with a leaf whose name needs CSV quoting.
+const char* kSmallMobile = R"({
+  "name": "red leaf, blue ball",
+  "balance": {"mode": "mass", "total_mass": 0.3},
+  "components": [
+    {"name": "hook", "fixed": true,
+     "shapes": [{"sphere": {"center": [0, 2, 0], "radius": 0.01}}]},
+    {"name": "top bar", "parent": "hook", "joint": [0, 2, 0],
+     "shapes": [{"wire": {"from": [0, 2, 0], "to": [0, 1.8, 0], "radius": 0.0005}},
+                {"wire": {"from": [-0.5, 1.8, 0], "to": [0.5, 1.8, 0], "radius": 0.002}}]},
+    {"name": "leaf, \"red\"", "parent": "top bar", "joint": [-0.5, 1.8, 0],
+     "shapes": [{"wire": {"from": [-0.5, 1.8, 0], "to": [-0.5, 1.6, 0], "radius": 0.0005}},
+                {"sphere": {"center": [-0.5, 1.5, 0], "radius": 0.1}}]},
+    {"name": "ball", "parent": "top bar", "joint": [0.5, 1.8, 0],
+     "shapes": [{"wire": {"from": [0.5, 1.8, 0], "to": [0.5, 1.6, 0], "radius": 0.0005}},
+                {"sphere": {"center": [0.5, 1.54, 0], "radius": 0.06}}]}
+  ]
+}
+)";
+
+TEST_F(Cli, GenerateIsValidAndDeterministic) {
+  const Result a = aloft("generate --components 31 --seed 5 --out a.json");
+  ASSERT_EQ(a.code, 0) << a.err;
+  const Result b = aloft("generate --components 31 --seed 5");
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(read(dir_ / "a.json"), b.out);
+  const Model m = load_mobile((dir_ / "a.json").string());
+  EXPECT_EQ(m.count, 31);
+  EXPECT_LT(m.balance.max_imbalance, 1e-6);
+  const Result c = aloft("generate --components 31 --seed 6 --total-mass 2");
+  ASSERT_EQ(c.code, 0);
+  EXPECT_NE(c.out, b.out);
+  EXPECT_NEAR(compile(parse_mobile_text(c.out)).balance.total_mass, 2.0, 1e-12);
+}
+
+TEST_F(Cli, InspectJson) {
+  ASSERT_EQ(aloft("generate -n 20 -s 2 -o m.json").code, 0);
+  const Result r = aloft("inspect m.json --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j.at("name").is_string());
+  EXPECT_EQ(j.at("file"), "m.json");
+  const json& balance = j.at("balance");
+  EXPECT_EQ(balance.at("mode"), "mass");
+  EXPECT_NEAR(balance.at("total_mass").get<double>(), 1.0, 1e-12);
+  EXPECT_LT(balance.at("max_imbalance").get<double>(), 1e-6);
+  EXPECT_TRUE(balance.at("notes").is_array());
+
+  const MobileSpec spec = parse_mobile_file((dir_ / "m.json").string());
+  const json& components = j.at("components");
+  ASSERT_TRUE(components.is_array());
+  ASSERT_EQ(components.size(), 20u);
+  auto is_vec = [](const json& v, size_t n) {
+    if (!v.is_array() || v.size() != n) return false;
+    for (const json& x : v)
+      if (!x.is_number()) return false;
+    return true;
+  };
+  int fixed = 0;
+  for (size_t i = 0; i < components.size(); ++i) {
+    const json& c = components[i];
+    SCOPED_TRACE(c.dump());
+    for (const char* key : {"name", "parent", "fixed", "mass", "com", "principal_moments", "rest_orientation", "joint"})
+      EXPECT_TRUE(c.contains(key)) << key;
+    EXPECT_EQ(c.at("name"), spec.components[i].name);  // file order
+    EXPECT_TRUE(c.at("fixed").is_boolean());
+    EXPECT_TRUE(c.at("mass").is_number());
+    EXPECT_GT(c.at("mass").get<double>(), 0);
+    EXPECT_TRUE(is_vec(c.at("com"), 3));
+    EXPECT_TRUE(is_vec(c.at("principal_moments"), 3));
+    ASSERT_TRUE(is_vec(c.at("rest_orientation"), 4));
+    double norm2 = 0;
+    for (const json& x : c.at("rest_orientation")) norm2 += x.get<double>() * x.get<double>();
+    EXPECT_NEAR(norm2, 1.0, 1e-12);
+    if (c.at("fixed").get<bool>()) {
+      ++fixed;
+      EXPECT_TRUE(c.at("parent").is_null());
+      EXPECT_TRUE(c.at("joint").is_null());
+    } else {
+      EXPECT_TRUE(c.at("parent").is_string());
+      EXPECT_EQ(c.at("parent"), *spec.components[i].parent);
+      EXPECT_TRUE(is_vec(c.at("joint"), 3));
+    }
+  }
+  EXPECT_EQ(fixed, 1);
+
+  const Result text = aloft("inspect m.json");
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("bar 1"), std::string::npos);
+  EXPECT_NE(text.out.find("mode mass"), std::string::npos);
+}
+
+TEST_F(Cli, SimulateWritesTrajectory) {
+  ASSERT_EQ(aloft("generate -n 9 -s 3 -o m.json").code, 0);
+  const Result r = aloft("simulate m.json --duration 0.05 --every 10 --out traj.csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("steps"), std::string::npos);
+  EXPECT_NE(r.out.find("energy drift"), std::string::npos);
+  EXPECT_NE(r.out.find("joint separation"), std::string::npos);
+  std::istringstream csv(read(dir_ / "traj.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line, "t,component,x,y,z,qw,qx,qy,qz");
+  std::vector<std::string> rows;
+  while (std::getline(csv, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 9u * 6u);  // 50 steps, a frame every 10 steps and t = 0
+  EXPECT_EQ(rows[0].rfind("0,hook,", 0), 0u);
+  for (const std::string& row : rows) EXPECT_EQ(std::count(row.begin(), row.end(), ','), 8) << row;
+
+  const Result quiet = aloft("simulate m.json -t 0.01 --quiet --damping-off --dt 0.0005");
+  EXPECT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.out, "");
+}
+
+TEST_F(Cli, SimulateQuotesNames) {
+  write(dir_ / "small.json", kSmallMobile);
+  const Result r = aloft("simulate small.json -t 0.002 -k 1 -o t.csv -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = read(dir_ / "t.csv");
+  EXPECT_NE(csv.find("\n0,\"leaf, \"\"red\"\"\",-0.5,"), std::string::npos) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 4 * 3);
+}
+
+TEST_F(Cli, BadFilesExitOneWithFileAndLine) {
+  write(dir_ / "syntax.json", "{\n  \"name\": \"x\",\n  \"components\": [ }\n}\n");
+  Result r = aloft("inspect syntax.json");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("aloft: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("syntax.json:3:"), std::string::npos) << r.err;
+
+  std::string text = kSmallMobile;
+  text.replace(text.find("\"radius\": 0.06"), 8, "\"radios\"");  // line 15
+  write(dir_ / "unknown.json", text);
+  r = aloft("simulate unknown.json -t 0.01");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("aloft: error: unknown.json:15:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("radios"), std::string::npos) << r.err;
+
+  r = aloft("inspect no-such-file.json --json");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("aloft: error: no-such-file.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cannot open"), std::string::npos) << r.err;
+
+  r = aloft("generate -n 5 --out no-such-dir/x.json");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("no-such-dir/x.json"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UsageErrorsExitTwo) {
+  write(dir_ / "small.json", kSmallMobile);
+  for (const char* args : {"", "frobnicate", "generate", "generate -n 1", "generate -n 10 --total-mass 0",
+                           "simulate small.json", "simulate small.json -t 0", "simulate small.json -t -1",
+                           "simulate small.json -t 1 --dt 0.02", "simulate small.json -t 1 --dt 0",
+                           "simulate small.json -t 1 --every 0", "inspect", "bench --sizes 1",
+                           "inspect small.json --bogus"}) {
+    const Result r = aloft(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_FALSE(r.err.empty()) << args;
+  }
+}
+
+TEST_F(Cli, HelpAndVersion) {
+  for (const char* sub : {"", "generate ", "inspect ", "simulate ", "bench "}) {
+    const Result r = aloft(std::string(sub) + "--help");
+    EXPECT_EQ(r.code, 0) << sub;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
+    EXPECT_NE(r.out.find("Examples"), std::string::npos) << sub;
+  }
+  const Result v = aloft("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_EQ(v.out.rfind("aloft ", 0), 0u) << v.out;
+}
+
+TEST_F(Cli, BenchRuns) {
+  const Result r = aloft("bench --sizes 7 --steps 20 --presets no-such-dir");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("steps/s"), std::string::npos);
+  EXPECT_NE(r.out.find("skipped"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace aloft
