@@ -224,7 +224,7 @@ Runner add_simulate(CLI::App& app) {
         energy += "; damping is on (--damping-off to check conservation)";
       std::printf("mobile            %s\n", model.name.c_str());
       std::printf("components        %d\n", model.count);
-      std::printf("steps             %lld of %g s\n", done, h);
+      std::printf("steps             %lld (dt = %g s)\n", done, h);
       std::printf("simulated time    %.6g s\n", s.time);
       std::printf("wall time         %.3f s\n", wall);
       std::printf("speed             %.0f steps/s (%.3g x real time)\n", wall > 0 ? done / wall : 0.0,
