@@ -113,6 +113,7 @@ std::string inspect_text(const Model& m) {
 Runner add_inspect(CLI::App& app) {
   struct Options {
     std::string file;
+    std::string balance = "file";
     bool json = false;
   };
   auto o = std::make_shared<Options>();
@@ -120,6 +121,7 @@ Runner add_inspect(CLI::App& app) {
       "inspect",
       "Show the masses, inertias, rest pose, joints and balance Aloft derives from a mobile file");
   sub->add_option("file", o->file, "The mobile file (JSON)")->type_name("FILE")->required();
+  add_balance_option(sub, o->balance);
   sub->add_flag("--json", o->json,
                 "Print JSON instead of a table: {name, file, balance {mode, total_mass, max_imbalance, notes}, "
                 "components [{name, parent, fixed, mass, com, principal_moments, rest_orientation [w,x,y,z], "
@@ -134,7 +136,7 @@ Runner add_inspect(CLI::App& app) {
       "  aloft inspect mobiles/steel-fish.json\n"
       "  aloft inspect random.json --json > random-inspect.json\n");
   return [o] {
-    const Model model = load_mobile(o->file);
+    const Model model = load_mobile_as(o->file, o->balance);
     const std::string text = o->json ? inspect_json(model) : inspect_text(model);
     std::fwrite(text.data(), 1, text.size(), stdout);
     if (std::fflush(stdout) != 0) throw Failure("cannot write to standard output");

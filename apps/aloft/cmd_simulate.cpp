@@ -124,6 +124,7 @@ class Progress {
 Runner add_simulate(CLI::App& app) {
   struct Options {
     std::string file;
+    std::string balance = "file";
     double duration = 0;
     double dt = 0;  // 0: the mobile's timestep
     int every = 10;
@@ -136,6 +137,7 @@ Runner add_simulate(CLI::App& app) {
       "simulate",
       "Simulate a mobile without a window and write its trajectory");
   sub->add_option("file", o->file, "The mobile file (JSON)")->type_name("FILE")->required();
+  add_balance_option(sub, o->balance);
   sub->add_option("-t,--duration", o->duration, "Simulated time (s, > 0)")
       ->type_name("T")
       ->required()
@@ -161,11 +163,12 @@ Runner add_simulate(CLI::App& app) {
       "  aloft simulate mobiles/steel-fish.json --duration 10\n"
       "  aloft simulate random.json --duration 2 --dt 0.0005 --every 20 --out trajectory.csv\n"
       "  aloft simulate random.json -t 60 --damping-off        # check energy conservation\n"
+      "  aloft simulate mobiles/steel-fish.json -t 30 --balance none   # as built: it swings\n"
       "\n"
       "Exit code 3 if the simulation fails (its state stops being finite); the CSV then holds the\n"
       "frames computed until then.\n");
   return [o] {
-    const Model model = load_mobile(o->file);
+    const Model model = load_mobile_as(o->file, o->balance);
     Simulation sim(model);
     if (o->dt > 0) sim.set_timestep(o->dt);
     if (o->damping_off) sim.set_damping(DampingSpec{});

@@ -169,4 +169,22 @@ std::string Table::str(const std::string& indent) const {
   return out;
 }
 
+void add_balance_option(CLI::App* sub, std::string& mode) {
+  sub->add_option("--balance", mode,
+                  "Balance mode: 'file' (as the mobile file says), or override it with 'mass' (derive masses so "
+                  "the drawn pose hangs still), 'joints' (move the hanging points) or 'none' (densities as "
+                  "given: an unbalanced mobile swings)")
+      ->type_name("MODE")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"file", "mass", "joints", "none"}));
+}
+
+aloft::Model load_mobile_as(const std::string& file, const std::string& balance_mode) {
+  aloft::MobileSpec spec = aloft::parse_mobile_file(file);
+  if (balance_mode == "mass") spec.balance.mode = aloft::BalanceMode::Mass;
+  if (balance_mode == "joints") spec.balance.mode = aloft::BalanceMode::Joints;
+  if (balance_mode == "none") spec.balance.mode = aloft::BalanceMode::None;
+  return aloft::compile(spec);
+}
+
 }  // namespace aloft::cli

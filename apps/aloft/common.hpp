@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "aloft/model.hpp"
+
 namespace aloft::cli {
 
 // Exit codes.
@@ -33,6 +35,13 @@ Runner add_generate(CLI::App& app);
 Runner add_inspect(CLI::App& app);
 Runner add_simulate(CLI::App& app);
 Runner add_bench(CLI::App& app);
+
+// The --balance option shared by inspect and simulate: "file" (default: as the mobile file says), or
+// "mass", "joints", "none" to override the file's balance mode.
+void add_balance_option(CLI::App* sub, std::string& mode);
+
+// parse_mobile_file + compile, with the balance mode overridden unless `balance_mode` is "file".
+aloft::Model load_mobile_as(const std::string& file, const std::string& balance_mode);
 
 // "aloft: error: <message>" on stderr.
 void print_error(const std::string& message);
