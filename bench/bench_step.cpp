@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "aloft/generate.hpp"
 #include "aloft/simulation.hpp"
 #include "bench_models.hpp"
 #include "dynamics/tree_solver.hpp"
@@ -142,7 +143,25 @@ void BM_Solve(benchmark::State& state, const std::string& key) {
   set_counters(state, model, cpu_seconds() - start);
 }
 
+// Loading: generate_mobile text -> parse_mobile_text -> compile, the whole path a 65535-component file
+// takes before its first step (items_per_second = components loaded per second).
+void BM_Load(benchmark::State& state, int components) {
+  aloft::GenerateOptions options;
+  options.components = components;
+  options.seed = 1;
+  const std::string text = aloft::generate_mobile(options);
+  for (auto _ : state) {
+    const aloft::Model model = aloft::compile(aloft::parse_mobile_text(text, "generated.json"));
+    benchmark::DoNotOptimize(model.mass.data());
+  }
+  state.SetItemsProcessed(state.iterations() * components);
+  state.counters["megabytes"] = static_cast<double>(text.size()) / 1e6;
+}
+
 void register_all() {
+  for (int n : {1023, 65535})
+    benchmark::RegisterBenchmark(("BM_Load/generated-" + std::to_string(n)).c_str(), BM_Load, n)
+        ->Unit(benchmark::kMillisecond);
   std::vector<std::string> keys = kPresets;
   for (int n : kGenerated) keys.push_back("generated-" + std::to_string(n));
   for (const std::string& key : keys)

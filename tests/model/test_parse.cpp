@@ -4,10 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -608,7 +606,7 @@ TEST(ParseLocator, SurvivesArbitraryBytes) {
   }
 }
 
-TEST(Parse, LargeMobileIsFast) {
+TEST(Parse, LargeMobileParsesWhole) {
   constexpr int kCount = 65535;
   std::string text = R"({"name": "big", "components": [
 {"name": "c0", "fixed": true, "shapes": [{"sphere": {"center": [0, 0, 0], "radius": 0.01}}]})";
@@ -621,22 +619,12 @@ TEST(Parse, LargeMobileIsFast) {
             "{\"sphere\": {\"center\": [0.25, " + y + ", 0.125], \"radius\": 0.01}}]}";
   }
   text += "\n]}\n";
-  // Wall time for the record; the check is on processor time (all threads), which a loaded machine
-  // (tests run in parallel) does not inflate much.
-  const auto start = std::chrono::steady_clock::now();
-  const std::clock_t cpu_start = std::clock();
+  // Speed is measured by the BM_Load benchmark (bench/bench_step.cpp), not here: this checks that a
+  // 65535-component file parses whole and that the locator still knows its last lines.
   const MobileSpec spec = parse_mobile_text(text, "big.json");
-  const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(spec.components.size(), static_cast<std::size_t>(kCount));
   EXPECT_EQ(spec.components.back().name, "c" + std::to_string(kCount - 1));
   EXPECT_EQ(spec.source.locate("components[65534].shapes[1].sphere.radius").line, 2 * kCount);
-  std::cout << "parsed " << text.size() / 1e6 << " MB, " << kCount << " components in " << seconds << " s ("
-            << cpu_seconds << " s of processor time)\n";
-#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__)
-  // ~0.5 s wall, ~0.8 s processor time on an idle machine; quadratic time would take minutes.
-  EXPECT_LT(cpu_seconds, 3.0);
-#endif
 }
 
 // ------------------------------------------------------------------------------------------------
