@@ -1,5 +1,5 @@
 // aloft bench: simulation speed (steps per second) on the preset mobiles and on generated mobiles of
-// growing size. Each mobile is set swinging by a short gust, then timed over 5 repetitions of enough steps
+// growing size. Each mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5 repetitions of enough steps
 // for at least 0.5 s each (or --steps); the median is reported.
 
 #include <algorithm>
@@ -49,6 +49,7 @@ std::string cpu_model() {
 
 struct Measurement {
   double steps_per_second = 0;
+  double subdivided = 0;  // step halvings per timed step (0: no step had to be divided for a fast spin)
   long long steps_per_repetition = 0;
   std::string failure;  // non-empty if the simulation failed
 };
@@ -57,12 +58,13 @@ Measurement measure(const Model& model, long long fixed_steps) {
   constexpr int kRepetitions = 5;
   Measurement out;
   Simulation sim(model);
-  // Warm up with a gust: a horizontal push on every component, turning with the index, so that the mobile
-  // swings (a balanced mobile at rest would be an unrepresentatively easy case).
+  // Warm up with a breeze: a horizontal push of 0.2 g on every component, turning with the index, for up to
+  // 0.3 s, so that the mobile swings (a balanced mobile at rest would be an unrepresentatively easy case)
+  // as it would in a room's draught, at a few tenths of a radian per second.
   sim.loads().resize(model.count);
   for (int i = 1; i < model.count; ++i) {
     const double a = 2.399963 * i;  // golden angle
-    sim.loads().force[i] = 1.5 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+    sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
   }
   const auto warm_start = Clock::now();
   long long warm_steps = 0;
@@ -79,6 +81,8 @@ Measurement measure(const Model& model, long long fixed_steps) {
       fixed_steps > 0 ? fixed_steps : std::max(3LL, static_cast<long long>(std::ceil(0.5 * warm_rate)));
 
   std::vector<double> rates;
+  const long long subdivisions_before = sim.subdivisions();
+  const long long steps_before = sim.step_count();
   for (int r = 0; r < kRepetitions; ++r) {
     const auto start = Clock::now();
     for (long long s = 0; s < out.steps_per_repetition; ++s) {
@@ -98,6 +102,8 @@ Measurement measure(const Model& model, long long fixed_steps) {
   }
   std::sort(rates.begin(), rates.end());
   out.steps_per_second = rates[rates.size() / 2];
+  out.subdivided = static_cast<double>(sim.subdivisions() - subdivisions_before) /
+                   static_cast<double>(std::max(1LL, sim.step_count() - steps_before));
   return out;
 }
 
@@ -106,8 +112,8 @@ void print_row(const std::string& name, int components, const Measurement& m) {
     std::printf("%-28s %10d  failed: %s\n", name.c_str(), components, m.failure.c_str());
   } else {
     const double us = 1e6 / m.steps_per_second;
-    std::printf("%-28s %10d %12.1f %12.2f %14.4f\n", name.c_str(), components, m.steps_per_second, us,
-                us / std::max(1, components - 1));
+    std::printf("%-28s %10d %12.1f %12.2f %14.4f %10.4f\n", name.c_str(), components, m.steps_per_second, us,
+                us / std::max(1, components - 1), m.subdivided);
   }
   std::fflush(stdout);
 }
@@ -136,8 +142,9 @@ Runner add_bench(CLI::App& app) {
   sub->footer(
       "Prints steps per second, microseconds per step and per moving component per step for the preset\n"
       "mobiles (steel-fish.json and southern-cross.json; a missing one is skipped with a note) and for\n"
-      "generated mobiles (seed 1). Each mobile is set swinging by a short gust, then timed over 5\n"
-      "repetitions of at least 0.5 s (or --steps steps); the median is reported.\n"
+      "generated mobiles (seed 1). Each mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5\n"
+      "repetitions of at least 0.5 s (or --steps steps); the median is reported. \"halvings\" counts\n"
+      "how often per step the step had to be halved because something spun too fast for it.\n"
       "\n"
       "Examples:\n"
       "  aloft bench\n"
@@ -148,9 +155,10 @@ Runner add_bench(CLI::App& app) {
     const std::string dir = o->presets.empty() ? (fs::path(source_dir()) / "mobiles").string() : o->presets;
     std::printf("aloft bench: %s, %u cores; build %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
                 ALOFT_BUILD_TYPE);
-    std::printf("median of 5 repetitions of %s, after a warm-up with a gust\n\n",
+    std::printf("median of 5 repetitions of %s, after a warm-up in a breeze\n\n",
                 o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s");
-    std::printf("%-28s %10s %12s %12s %14s\n", "mobile", "components", "steps/s", "us/step", "us/comp/step");
+    std::printf("%-28s %10s %12s %12s %14s %10s\n", "mobile", "components", "steps/s", "us/step", "us/comp/step",
+                "halvings");
     std::fflush(stdout);
     std::vector<std::string> notes;
     for (const char* preset : {"steel-fish.json", "southern-cross.json"}) {

@@ -13,8 +13,9 @@
 //
 // Balance: mode "mass" (compile() scales the masses). The generator repeats compile()'s per-bar
 // computation (scale factors closest to all-ones that balance the bar, balance.cpp) along the bar's line
-// with the base (steel) masses; when a random pivot would need a factor below kMinFactor, the pivot moves
-// to where the base masses balance, so every factor is comfortably positive.
+// with the base (steel) masses; each pivot sits a little off the point where the base masses balance, and
+// moves onto it when a factor would leave [kMinFactor, 1/kMinFactor], so the derived masses stay close to
+// the steel ones however deep the tree.
 //
 // Determinism: std::mt19937 with our own mapping to numbers, and every coordinate an integer number of
 // micrometres, printed exactly; so the same options give the same text with any compiler and library.
@@ -41,7 +42,7 @@ constexpr double kDensity = 7850;         // steel, the format's default
 constexpr Micro kThreadRadius = 500;      // 0.5 mm
 constexpr Micro kPlateThickness = 2000;   // 2 mm
 constexpr Micro kHookRadius = 10000;      // 1 cm
-constexpr double kMinFactor = 0.25;       // smallest acceptable balance factor of the base design
+constexpr double kMinFactor = 0.8;        // balance factors of the base design stay in [0.8, 1.25]
 
 class Random {
  public:
@@ -240,9 +241,14 @@ class Generator {
       const double arm[3] = {mw * (0.5 - f) * l / (mt + mw), -f * l, (1 - f) * l};
       return smallest_factor(m, arm, 3, x);
     };
-    double f = random_.uniform(0.35, 0.65);
+    // The pivot lies near where the base masses balance, a little off at random, so that compile()'s
+    // factors stay near 1: they multiply down the tree, and factors far from 1 at every level would give
+    // a deep mobile pieces of absurdly different weights (and spin its lightest ones at hundreds of rad/s).
+    const double balanced = (0.5 * mw + sb) / (mw + sa + sb);
+    double f = std::clamp(balanced + random_.uniform(-0.03, 0.03), 0.1, 0.9);
     double x[3];
-    if (factors(f, x) < kMinFactor) f = (0.5 * mw + sb) / (mw + sa + sb);  // balanced at base masses
+    factors(f, x);
+    if (std::min({x[0], x[1], x[2]}) < kMinFactor || std::max({x[0], x[1], x[2]}) > 1 / kMinFactor) f = balanced;
     n.minus = -100 * std::llround(f * static_cast<double>(length) / 100);
     n.plus = length + n.minus;
     // The sub-mass as compile() computes it, with the factors of the pivot actually written.
