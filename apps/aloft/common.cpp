@@ -1,5 +1,7 @@
 #include "common.hpp"
 
+#include <optional>
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -77,18 +79,27 @@ std::string source_dir() {
 #endif
 }
 
+namespace {
+
+// The whole of `input` read as a double, or nothing.
+std::optional<double> read_number(const std::string& input) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(input, &used);
+    if (used == input.size()) return v;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 CLI::Validator positive_number() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        double v = 0;
-        try {
-          std::size_t used = 0;
-          v = std::stod(input, &used);
-          if (used != input.size()) return "must be a number, got \"" + input + "\"";
-        } catch (const std::exception&) {
-          return "must be a number, got \"" + input + "\"";
-        }
-        if (!(v > 0) || !std::isfinite(v)) return "must be a positive number, got " + input;
+        const std::optional<double> v = read_number(input);
+        if (!v) return "must be a number, got \"" + input + "\"";
+        if (!(*v > 0) || !std::isfinite(*v)) return "must be a positive number, got " + input;
         return {};
       },
       "");
@@ -111,14 +122,9 @@ CLI::Validator integer_in(long long lo, long long hi) {
 CLI::Validator timestep_range() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        double v = 0;
-        try {
-          std::size_t used = 0;
-          v = std::stod(input, &used);
-          if (used != input.size()) return "must be a number of seconds, got \"" + input + "\"";
-        } catch (const std::exception&) {
-          return "must be a number of seconds, got \"" + input + "\"";
-        }
+        const std::optional<double> parsed = read_number(input);
+        if (!parsed) return "must be a number of seconds, got \"" + input + "\"";
+        const double v = *parsed;
         if (!(v > 0 && v <= 0.01)) return "must be greater than 0 and at most 0.01 s, got " + input;
         return {};
       },

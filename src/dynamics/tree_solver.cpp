@@ -6,13 +6,8 @@ namespace aloft {
 
 namespace {
 
-// World inertia R diag(I) R^T of a body with principal moments `moments` and orientation `q`.
-Mat3 world_inertia_of(const Quat& q, const Vec3& moments) {
-  const Mat3 r = q.toRotationMatrix();
-  return r * moments.asDiagonal() * r.transpose();
-}
-
-// Both R diag(I) R^T and R diag(1/I) R^T.
+// World inertia R diag(I) R^T of a body with principal moments I and orientation q, and its inverse
+// R diag(1/I) R^T.
 void world_inertia_pair(const Quat& q, const Vec3& moments, Mat3& inertia, Mat3& inverse) {
   const Mat3 r = q.toRotationMatrix();
   inertia = r * moments.asDiagonal() * r.transpose();
@@ -138,7 +133,9 @@ Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state) {
   for (int i = 1; i < model.count; ++i) {
     const int b = 6 * (i - 1);
     h.block<3, 3>(b, b) = model.mass[i] * Mat3::Identity();
-    h.block<3, 3>(b + 3, b + 3) = world_inertia_of(state.orientation[i], model.principal_moments[i]);
+    Mat3 inertia, inverse;
+    world_inertia_pair(state.orientation[i], model.principal_moments[i], inertia, inverse);
+    h.block<3, 3>(b + 3, b + 3) = inertia;
   }
   for (int k = 1; k < model.count; ++k) {
     const int row = 6 * m + 3 * (k - 1);

@@ -2,22 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <variant>
 
 #include "aloft/geometry.hpp"
+#include "common/overloaded.hpp"
 
 namespace aloft {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
+using internal::Overloaded;
 
 // Distance from p to the closed segment [a, b] in the plane.
 double segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {

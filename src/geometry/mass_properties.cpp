@@ -8,17 +8,19 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <variant>
 
 #include "aloft/geometry.hpp"
+#include "common/overloaded.hpp"
 
 namespace aloft {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // ---------------------------------------------------------------------------------------------------
 // Projection integrals. For a polygon Pi in the (alpha, beta) plane, pi_pq = integral over Pi of
@@ -277,12 +279,7 @@ MassProperties plate_mass_properties(const Plate& p) {
   return vi.result();
 }
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
+using internal::Overloaded;
 
 }  // namespace
 

@@ -3,21 +3,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <variant>
 
 #include "aloft/geometry.hpp"
+#include "common/overloaded.hpp"
 
 namespace aloft {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
+using internal::Overloaded;
 
 // UV sphere with the poles on the world y axis: `sectors` meridians, `rings` latitude bands. All vertices
 // lie on the sphere, so the polyhedron is inscribed.
