@@ -74,14 +74,21 @@ void set_counters(benchmark::State& state, const Model& model, double loop_secon
         loop_seconds * 1e6 / (static_cast<double>(state.iterations()) * (model.count - 1));
 }
 
-void BM_Step(benchmark::State& state, const std::string& key) {
+// The model for `key`, or nothing after marking the benchmark skipped (a missing preset).
+const Model* model_or_skip(benchmark::State& state, const std::string& key) {
   const Entry& entry = model_entry(key);
   if (!entry.model) {
     state.SkipWithError(entry.error.c_str());
-    for (auto _ : state) {}
-    return;
+    for (auto _ : state) {
+    }
   }
-  const Model& model = *entry.model;
+  return entry.model.get();
+}
+
+void BM_Step(benchmark::State& state, const std::string& key) {
+  const Model* found = model_or_skip(state, key);
+  if (!found) return;
+  const Model& model = *found;
   aloft::Simulation sim(model, aloft::bench::swinging_state(model));
   const double start = cpu_seconds();
   for (auto _ : state) {
@@ -96,13 +103,9 @@ void BM_Step(benchmark::State& state, const std::string& key) {
 }
 
 void BM_Factor(benchmark::State& state, const std::string& key) {
-  const Entry& entry = model_entry(key);
-  if (!entry.model) {
-    state.SkipWithError(entry.error.c_str());
-    for (auto _ : state) {}
-    return;
-  }
-  const Model& model = *entry.model;
+  const Model* found = model_or_skip(state, key);
+  if (!found) return;
+  const Model& model = *found;
   const aloft::State pose = aloft::bench::swinging_state(model);
   aloft::TreeSolver solver(model);
   const double start = cpu_seconds();
@@ -114,13 +117,9 @@ void BM_Factor(benchmark::State& state, const std::string& key) {
 }
 
 void BM_Solve(benchmark::State& state, const std::string& key) {
-  const Entry& entry = model_entry(key);
-  if (!entry.model) {
-    state.SkipWithError(entry.error.c_str());
-    for (auto _ : state) {}
-    return;
-  }
-  const Model& model = *entry.model;
+  const Model* found = model_or_skip(state, key);
+  if (!found) return;
+  const Model& model = *found;
   const aloft::State pose = aloft::bench::swinging_state(model);
   aloft::TreeSolver solver(model);
   solver.factor(pose);
