@@ -7,6 +7,11 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev
+  libccd-dev                                   # collisions: GJK/EPA for convex pieces
+  libsdl2-dev sox                              # microphone capture (SDL2); sox makes test signals
+  libglfw3-dev libimgui-dev libstb-dev         # the viewer: window, panel, PNG writing
+  libgl-dev libegl-dev libgl1-mesa-dri         # OpenGL (Mesa's llvmpipe) and headless EGL
+  xvfb xauth ffmpeg                            # viewer tests under a virtual display; video encoding
   "$@"
 )
 
