@@ -190,4 +190,6 @@ Runner add_bench(CLI::App& app) {
   };
 }
 
+static const CommandRegistration registration{"bench", 90, add_bench};
+
 }  // namespace aloft::cli

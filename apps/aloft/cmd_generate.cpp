@@ -54,4 +54,6 @@ Runner add_generate(CLI::App& app) {
   };
 }
 
+static const CommandRegistration registration{"generate", 10, add_generate};
+
 }  // namespace aloft::cli

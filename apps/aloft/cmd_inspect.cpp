@@ -144,4 +144,6 @@ Runner add_inspect(CLI::App& app) {
   };
 }
 
+static const CommandRegistration registration{"inspect", 20, add_inspect};
+
 }  // namespace aloft::cli

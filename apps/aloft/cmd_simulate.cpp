@@ -243,4 +243,6 @@ Runner add_simulate(CLI::App& app) {
   };
 }
 
+static const CommandRegistration registration{"simulate", 30, add_simulate};
+
 }  // namespace aloft::cli

@@ -1,5 +1,6 @@
 #include "common.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include <unistd.h>
@@ -191,6 +192,29 @@ aloft::Model load_mobile_as(const std::string& file, const std::string& balance_
   if (balance_mode == "joints") spec.balance.mode = aloft::BalanceMode::Joints;
   if (balance_mode == "none") spec.balance.mode = aloft::BalanceMode::None;
   return aloft::compile(spec);
+}
+
+}  // namespace aloft::cli
+
+namespace aloft::cli {
+
+namespace {
+// Function-local so that it exists before any registration runs (static initialisation order).
+std::vector<CommandEntry>& command_registry() {
+  static std::vector<CommandEntry> registry;
+  return registry;
+}
+}  // namespace
+
+CommandRegistration::CommandRegistration(const char* name, int order, AddCommand add) {
+  command_registry().push_back({name, order, add});
+}
+
+std::vector<CommandEntry> registered_commands() {
+  std::vector<CommandEntry> commands = command_registry();
+  std::stable_sort(commands.begin(), commands.end(),
+                   [](const CommandEntry& x, const CommandEntry& y) { return x.order < y.order; });
+  return commands;
 }
 
 }  // namespace aloft::cli

@@ -30,11 +30,21 @@ class Failure : public std::runtime_error {
 // A subcommand's body, run after the command line was parsed; returns the exit code.
 using Runner = std::function<int()>;
 
-// Each subcommand adds itself to `app` and returns what runs it.
-Runner add_generate(CLI::App& app);
-Runner add_inspect(CLI::App& app);
-Runner add_simulate(CLI::App& app);
-Runner add_bench(CLI::App& app);
+// Each subcommand lives in its own file (cmd_<name>.cpp) and registers itself there, at static
+// initialisation, with a function that adds it to `app` and returns what runs it:
+//     static const CommandRegistration registration{"simulate", 30, add_simulate};
+// `order` sets where it appears in `aloft --help` (ascending). No other file needs to change.
+using AddCommand = Runner (*)(CLI::App& app);
+struct CommandEntry {
+  const char* name;
+  int order;
+  AddCommand add;
+};
+struct CommandRegistration {
+  CommandRegistration(const char* name, int order, AddCommand add);
+};
+// Every registered command, sorted by order.
+std::vector<CommandEntry> registered_commands();
 
 // The --balance option shared by inspect and simulate: "file" (default: as the mobile file says), or
 // "mass", "joints", "none" to override the file's balance mode.

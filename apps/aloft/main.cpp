@@ -33,11 +33,9 @@ int main(int argc, char** argv) {
 
   std::map<const CLI::App*, Runner> runners;
   try {
-    const std::pair<const char*, Runner (*)(CLI::App&)> commands[] = {
-        {"generate", add_generate}, {"inspect", add_inspect}, {"simulate", add_simulate}, {"bench", add_bench}};
-    for (const auto& [name, add] : commands) {
-      Runner run = add(app);
-      runners[app.get_subcommand(name)] = std::move(run);
+    for (const CommandEntry& command : registered_commands()) {
+      Runner run = command.add(app);
+      runners[app.get_subcommand(command.name)] = std::move(run);
     }
   } catch (const std::exception& e) {
     print_error(std::string("internal: ") + e.what());
