@@ -1,0 +1,171 @@
+// aloft render: the mobile as it moves, rendered with no window (OpenGL through EGL, no X server) to a
+// video, a still PNG or a directory of PNG frames. The same renderer as `aloft view`.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "aloft/render/frame_target.hpp"
+#include "aloft/render/headless_context.hpp"
+#include "aloft/render/image_output.hpp"
+#include "aloft/render/renderer.hpp"
+#include "aloft/simulation.hpp"
+#include "common.hpp"
+#include "view/camera_flags.hpp"
+
+namespace aloft::cli {
+
+namespace {
+
+// A progress bar on stderr: redrawn in place on a terminal, a line per 10 % otherwise.
+class RenderProgress {
+ public:
+  RenderProgress(bool enabled, long long total) : enabled_(enabled), total_(total), tty_(is_terminal(stderr)) {}
+  void update(long long done) {
+    if (!enabled_ || total_ <= 1) return;
+    const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+    if (tty_) {
+      constexpr int kWidth = 30;
+      const int filled = static_cast<int>(fraction * kWidth);
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      const double left = done > 0 ? elapsed * static_cast<double>(total_ - done) / static_cast<double>(done) : 0;
+      std::fprintf(stderr, "\r  rendering [%.*s%*s] %3.0f%%  frame %lld/%lld  %.0f s left ", filled,
+                   "##############################", kWidth - filled, "", fraction * 100, done, total_, left);
+      std::fflush(stderr);
+      shown_ = true;
+    } else {
+      const int decile = static_cast<int>(fraction * 10);
+      if (decile <= decile_) return;
+      decile_ = decile;
+      std::fprintf(stderr, "aloft: rendering: %d%% (frame %lld of %lld)\n", decile * 10, done, total_);
+    }
+  }
+  void finish() {
+    if (shown_) std::fprintf(stderr, "\r%*s\r", 78, "");
+  }
+
+ private:
+  bool enabled_;
+  long long total_;
+  bool tty_;
+  int decile_ = 0;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+Runner add_render(CLI::App& app) {
+  struct Options {
+    std::string file;
+    std::string balance = "file";
+    double duration = 5;
+    std::string out;
+    int width = 1280;
+    int height = 720;
+    double fps = 30;
+    int samples = 4;
+    bool no_shadows = false;
+    bool quiet = false;
+    CameraFlags camera;
+  };
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("render", "Render a mobile as it moves to a video or images, with no window");
+  sub->add_option("file", o->file, "The mobile file (JSON)")->type_name("FILE")->required();
+  sub->add_option("-o,--out", o->out, "Output: a video (.mp4 .gif .webm .mkv), one image (.png: the last frame) or "
+                                      "a directory for PNG frames (ends with /)")
+      ->type_name("PATH")
+      ->required();
+  sub->add_option("-t,--duration", o->duration, "Simulated time (s, > 0)")
+      ->type_name("T")
+      ->capture_default_str()
+      ->check(positive_number());
+  add_balance_option(sub, o->balance);
+  sub->add_option("--width", o->width, "Image width (pixels)")->capture_default_str()->check(integer_in(16, 8192));
+  sub->add_option("--height", o->height, "Image height (pixels)")->capture_default_str()->check(integer_in(16, 8192));
+  sub->add_option("--fps", o->fps, "Frames per simulated second (1..240)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 240.0));
+  sub->add_option("--msaa", o->samples, "Anti-aliasing samples per pixel (0 or 1: off)")
+      ->capture_default_str()
+      ->check(integer_in(0, 16));
+  sub->add_flag("--no-shadows", o->no_shadows, "Draw without shadows");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
+  o->camera.add_to(sub);
+  sub->footer(
+      "Simulates the mobile from its designed pose at rest (as 'aloft simulate') and draws a frame every\n"
+      "1/fps simulated seconds: frames at t = 0, 1/fps, ... (duration x fps of them). Rendering is offscreen\n"
+      "through EGL on Mesa: no display or X server is needed. Videos are encoded by ffmpeg.\n"
+      "\n"
+      "Examples:\n"
+      "  aloft render mobiles/steel-fish.json --balance none --duration 10 --out fish.mp4\n"
+      "  aloft render mobiles/southern-cross.json --duration 0.001 --out cross.png --width 1920 --height 1080\n"
+      "  aloft render mobiles/steel-fish.json -t 4 --fps 15 --width 480 --height 270 --out fish.gif\n"
+      "  aloft render mobiles/steel-fish.json -t 2 --out frames/ --yaw 30 --pitch 20 --distance 5\n");
+  return [o] {
+    const Model model = load_mobile_as(o->file, o->balance);
+    Simulation sim(model);
+
+    render::HeadlessContext context;
+    render::Renderer renderer;
+    renderer.set_model(model);
+    render::FrameTarget target;
+    target.resize(o->width, o->height, o->samples);
+    const render::OrbitCamera camera =
+        o->camera.apply(render::framing_camera(renderer.scene(), static_cast<double>(o->width) / o->height));
+    render::DrawOptions options;
+    options.shadows = !o->no_shadows;
+
+    render::FrameSink sink(o->out, o->width, o->height, o->fps);
+    const long long frames = sink.wants_every_frame() ? std::max(1LL, std::llround(o->duration * o->fps)) : 1;
+    const double frame_time = 1 / o->fps;
+    std::vector<std::uint8_t> pixels;
+    RenderProgress progress(!o->quiet, frames);
+    const auto start = std::chrono::steady_clock::now();
+    const auto draw_frame = [&] {
+      target.bind();
+      renderer.draw(sim.state(), camera, o->width, o->height, options);
+      target.resolve();
+      target.read_rgba(pixels);
+      sink.add_frame(pixels);
+    };
+    if (!sink.wants_every_frame()) {
+      // One still: the mobile at t = duration.
+      if (!sim.advance(o->duration)) {
+        print_error(sim.failure() ? sim.failure()->message : "the simulation failed");
+        return kExitSimulation;
+      }
+      draw_frame();
+    } else {
+      for (long long k = 0; k < frames; ++k) {
+        // Frame k shows t = k / fps: step the physics up to that time first.
+        const double t = static_cast<double>(k) * frame_time;
+        if (t > sim.state().time && !sim.advance(t - sim.state().time)) {
+          progress.finish();
+          sink.finish();
+          print_error(sim.failure() ? sim.failure()->message : "the simulation failed");
+          return kExitSimulation;
+        }
+        draw_frame();
+        progress.update(k + 1);
+      }
+    }
+    progress.finish();
+    const std::string written = sink.finish();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!o->quiet) {
+      std::printf("mobile     %s\n", model.name.c_str());
+      std::printf("written    %s (%s, %.3g s simulated)\n", o->out.c_str(), written.c_str(), sim.state().time);
+      std::printf("wall time  %.2f s (%.1f frames/s) on %s\n", wall, static_cast<double>(frames) / wall,
+                  context.description().c_str());
+      std::fflush(stdout);
+    }
+    return kExitOk;
+  };
+}
+
+static const CommandRegistration registration{"render", 60, add_render};
+
+}  // namespace aloft::cli

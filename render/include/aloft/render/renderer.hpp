@@ -1,0 +1,67 @@
+#pragma once
+// The gallery renderer: the mobile's components lit and shaded in their colours, on a floor in front of
+// a wall that both receive its soft shadow (a shadow map from a warm spot light, filtered with PCF).
+// Needs a current OpenGL 3.3 core (or ES 3.0) context; draws into whatever framebuffer is bound, which
+// should be multisampled for anti-aliasing (see FrameTarget).
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "aloft/model.hpp"
+#include "aloft/render/camera.hpp"
+#include "aloft/render/scene_mesh.hpp"
+#include "aloft/state.hpp"
+
+namespace aloft::render {
+
+struct DrawOptions {
+  bool shadows = true;
+  bool room = true;               // floor and wall
+  int highlighted = -1;           // component drawn with a warm glow (the grabbed one), -1: none
+  int shadow_map_size = 2048;     // texels per side
+};
+
+// Line segments drawn over the scene (depth-tested): the wind cone, the grab spring.
+struct LineSet {
+  std::vector<Vec3> points;               // pairs: segment k is points[2k] -> points[2k+1], world, m
+  std::array<float, 4> color{0, 0, 0, 1}; // sRGB, alpha
+};
+
+// Where the floor and the wall stand for a mobile, and where the key light hangs: derived from its rest
+// bounds so that every mobile gets the same composition.
+struct Room {
+  double floor_y = 0;      // m
+  double wall_z = -1;      // m: the wall is the plane z = wall_z, facing +z
+  Vec3 light_position;     // m, world
+  Vec3 light_target;       // m, world: the spot's aim (the middle of the mobile)
+  double light_radius = 1; // m: radius of a sphere around light_target that holds the mobile in any pose
+};
+Room room_for(const SceneMesh& scene);
+
+// A camera that frames the whole mobile (and some floor and wall) for the given aspect ratio.
+OrbitCamera framing_camera(const SceneMesh& scene, double aspect);
+
+class Renderer {
+ public:
+  // `gles`: compile shaders as GLSL ES 3.00 (for an ES or WebGL2 context) instead of GLSL 3.30 core.
+  explicit Renderer(bool gles = false);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Build and upload the meshes of `model` (replacing the previous model's).
+  void set_model(const Model& model);
+  const SceneMesh& scene() const;
+  const Room& room() const;
+
+  // Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport.
+  void draw(const State& state, const OrbitCamera& camera, int width, int height, const DrawOptions& options,
+            const std::vector<LineSet>& lines = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace aloft::render

@@ -1,0 +1,295 @@
+#include "aloft/render/renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "aloft/render/gl.hpp"
+#include "gl_program.hpp"
+#include "shaders.hpp"
+
+namespace aloft::render {
+
+namespace {
+
+// Gallery colours (sRGB) and finishes.
+constexpr float kFloorColor[3] = {0.60f, 0.58f, 0.55f};   // pale concrete
+constexpr float kWallColor[3] = {0.84f, 0.82f, 0.78f};    // warm white
+constexpr float kBackground[3] = {0.16f, 0.16f, 0.17f};   // beyond the room (seen from behind the wall)
+constexpr float kMobileSpecular = 0.35f, kMobileShininess = 48.0f;  // painted steel
+constexpr float kRoomSpecular = 0.03f, kRoomShininess = 8.0f;       // matt paint
+// Soft-shadow filter radius as a fraction of the shadow map's width (with 2048 texels: 5 texels).
+constexpr float kShadowRadius = 0.0025f;
+
+void set_mat4(GLint location, const Mat4f& m) { glUniformMatrix4fv(location, 1, GL_FALSE, m.data()); }
+void set_vec3(GLint location, const Vec3& v) {
+  glUniform3f(location, static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()));
+}
+
+// Quad as two triangles, each vertex position + normal.
+void add_quad(std::vector<float>& out, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& n) {
+  for (const Vec3* p : {&a, &b, &c, &a, &c, &d})
+    for (double x : {p->x(), p->y(), p->z(), n.x(), n.y(), n.z()}) out.push_back(static_cast<float>(x));
+}
+
+}  // namespace
+
+Room room_for(const SceneMesh& scene) {
+  Room room;
+  const Bounds& b = scene.rest_bounds;
+  const Vec3 hook = scene.hook;
+  const double height = std::max(hook.y() - b.min.y(), 0.1);
+  // A standing piece (its fixed stand reaches the lowest point) stands on the floor; a hanging one hangs
+  // well above it.
+  room.floor_y = scene.fixed_min_y <= b.min.y() + 0.02 ? b.min.y() : b.min.y() - std::max(0.9, 0.6 * height);
+  room.wall_z = std::min(hook.z() - scene.reach, b.min.z()) - 0.45;
+  room.light_target = Vec3(hook.x(), (std::max(hook.y(), b.max.y()) + b.min.y()) / 2, hook.z());
+  room.light_radius = std::hypot(scene.reach, (std::max(hook.y(), b.max.y()) - b.min.y()) / 2) + 0.05;
+  // Above, in front and to the left, so the shadow falls behind and to the right on the wall and floor.
+  const Vec3 direction = Vec3(-0.4, 0.62, 1.0).normalized();
+  room.light_position = room.light_target + direction * std::max(3.0, 3.2 * room.light_radius);
+  return room;
+}
+
+OrbitCamera framing_camera(const SceneMesh& scene, double aspect) {
+  OrbitCamera camera;
+  const Bounds& b = scene.rest_bounds;
+  const double top = std::max(scene.hook.y(), b.max.y());
+  const double half_height = (top - b.min.y()) / 2 + 0.1;
+  const double half_width = scene.reach + 0.1;
+  camera.target = Vec3((b.min.x() + b.max.x()) / 2, (top + b.min.y()) / 2 - 0.1, scene.hook.z());
+  camera.yaw = 0.28;
+  camera.pitch = 0.12;
+  const double t = std::tan(camera.fov_y / 2);
+  camera.distance = 1.05 * std::max(half_height / t, half_width / (t * std::max(aspect, 0.2))) + 0.5 * scene.reach;
+  return camera;
+}
+
+struct Renderer::Impl {
+  bool gles;
+  GlProgram lit;
+  GlProgram depth;
+  GlProgram line;
+  SceneMesh scene;
+  Room room;
+  std::vector<float> colors;               // per component, sRGB
+  std::vector<std::pair<int, int>> ranges; // per component: first vertex, vertex count
+  GLuint mobile_vao = 0, mobile_vbo = 0;
+  GLuint room_vao = 0, room_vbo = 0;
+  int room_vertices = 0;
+  GLuint line_vao = 0, line_vbo = 0;
+  GLuint shadow_texture = 0, shadow_fbo = 0;
+  int shadow_size = 0;
+
+  explicit Impl(bool gles_)
+      : gles(gles_),
+        lit(shaders::glsl_source(shaders::kLitVertex, gles_), shaders::glsl_source(shaders::kLitFragment, gles_),
+            "lit"),
+        depth(shaders::glsl_source(shaders::kDepthVertex, gles_),
+              shaders::glsl_source(shaders::kDepthFragment, gles_), "shadow"),
+        line(shaders::glsl_source(shaders::kLineVertex, gles_), shaders::glsl_source(shaders::kLineFragment, gles_),
+             "line") {
+    glGenVertexArrays(1, &mobile_vao);
+    glGenBuffers(1, &mobile_vbo);
+    glGenVertexArrays(1, &room_vao);
+    glGenBuffers(1, &room_vbo);
+    glGenVertexArrays(1, &line_vao);
+    glGenBuffers(1, &line_vbo);
+    glBindVertexArray(line_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, line_vbo);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+    glBindVertexArray(0);
+    check_gl("renderer setup");
+  }
+
+  ~Impl() {
+    glDeleteVertexArrays(1, &mobile_vao);
+    glDeleteBuffers(1, &mobile_vbo);
+    glDeleteVertexArrays(1, &room_vao);
+    glDeleteBuffers(1, &room_vbo);
+    glDeleteVertexArrays(1, &line_vao);
+    glDeleteBuffers(1, &line_vbo);
+    if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+    if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+  }
+
+  static void upload(GLuint vao, GLuint vbo, const std::vector<float>& data) {
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+  }
+
+  void ensure_shadow_map(int size) {
+    if (size == shadow_size) return;
+    if (!shadow_texture) glGenTextures(1, &shadow_texture);
+    if (!shadow_fbo) glGenFramebuffers(1, &shadow_fbo);
+    glBindTexture(GL_TEXTURE_2D, shadow_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_texture, 0);
+    const GLenum none = GL_NONE;
+    glDrawBuffers(1, &none);
+    glReadBuffer(GL_NONE);
+    shadow_size = size;
+  }
+
+  Mat4f light_view_proj() const {
+    const double dist = (room.light_position - room.light_target).norm();
+    const double half_angle = std::asin(std::min(0.95, room.light_radius / dist)) * 1.1;
+    const double near = std::max(0.05, dist - room.light_radius - 0.2);
+    const double far = dist + room.light_radius + 0.2;
+    return perspective(2 * half_angle, 1.0, near, far) * look_at(room.light_position, room.light_target, Vec3::UnitY());
+  }
+
+  void draw_mobile(GlProgram& program, const State& state, bool with_color, int highlighted) {
+    glBindVertexArray(mobile_vao);
+    const int n = std::min<int>(static_cast<int>(ranges.size()), static_cast<int>(state.position.size()));
+    for (int i = 0; i < n; ++i) {
+      if (ranges[i].second == 0) continue;
+      set_mat4(program.uniform("u_model"), rigid_transform(state.position[i], state.orientation[i]));
+      if (with_color) {
+        glUniform3fv(program.uniform("u_color"), 1, &colors[3 * i]);
+        glUniform1f(program.uniform("u_highlight"), i == highlighted ? 1.0f : 0.0f);
+      }
+      glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].second);
+    }
+  }
+};
+
+Renderer::Renderer(bool gles) : impl_(std::make_unique<Impl>(gles)) {}
+Renderer::~Renderer() = default;
+
+const SceneMesh& Renderer::scene() const { return impl_->scene; }
+const Room& Renderer::room() const { return impl_->room; }
+
+void Renderer::set_model(const Model& model) {
+  Impl& m = *impl_;
+  m.scene = build_scene_mesh(model);
+  m.room = room_for(m.scene);
+  std::vector<float> all;
+  m.ranges.clear();
+  m.colors.clear();
+  for (int i = 0; i < model.count; ++i) {
+    const ComponentMesh& c = m.scene.components[i];
+    m.ranges.emplace_back(static_cast<int>(all.size() / 6), c.vertex_count());
+    all.insert(all.end(), c.vertices.begin(), c.vertices.end());
+    m.colors.insert(m.colors.end(), {model.color[i].r, model.color[i].g, model.color[i].b});
+  }
+  Impl::upload(m.mobile_vao, m.mobile_vbo, all);
+
+  // The room: a floor and a back wall, wide enough to fill the view from any orbit in front of the wall.
+  const Room& r = m.room;
+  const double x0 = m.scene.hook.x() - 12, x1 = m.scene.hook.x() + 12;
+  const double z1 = r.wall_z + 24, y1 = r.floor_y + 12;
+  std::vector<float> room;
+  add_quad(room, Vec3(x0, r.floor_y, z1), Vec3(x1, r.floor_y, z1), Vec3(x1, r.floor_y, r.wall_z),
+           Vec3(x0, r.floor_y, r.wall_z), Vec3::UnitY());
+  add_quad(room, Vec3(x0, r.floor_y, r.wall_z), Vec3(x1, r.floor_y, r.wall_z), Vec3(x1, y1, r.wall_z),
+           Vec3(x0, y1, r.wall_z), Vec3::UnitZ());
+  m.room_vertices = static_cast<int>(room.size() / 6);
+  Impl::upload(m.room_vao, m.room_vbo, room);
+  check_gl("uploading the model");
+}
+
+void Renderer::draw(const State& state, const OrbitCamera& camera, int width, int height, const DrawOptions& options,
+                    const std::vector<LineSet>& lines) {
+  Impl& m = *impl_;
+  if (width <= 0 || height <= 0) return;
+  GLint target_fbo = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target_fbo);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+
+  // 1. Shadow map: depth of the mobile as the key light sees it.
+  const Mat4f light_vp = m.light_view_proj();
+  if (options.shadows) {
+    m.ensure_shadow_map(options.shadow_map_size);
+    glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
+    glViewport(0, 0, m.shadow_size, m.shadow_size);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_CULL_FACE);  // thin plates: both faces cast
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2.0f, 4.0f);  // against self-shadowing acne on lit faces
+    m.depth.use();
+    set_mat4(m.depth.uniform("u_light_view_proj"), light_vp);
+    m.draw_mobile(m.depth, state, false, -1);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target_fbo));
+  }
+
+  // 2. The scene from the camera.
+  glViewport(0, 0, width, height);
+  glClearColor(kBackground[0], kBackground[1], kBackground[2], 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  const Mat4f view_proj = camera.projection(static_cast<double>(width) / height) * camera.view();
+  m.lit.use();
+  set_mat4(m.lit.uniform("u_view_proj"), view_proj);
+  set_mat4(m.lit.uniform("u_light_view_proj"), light_vp);
+  set_vec3(m.lit.uniform("u_eye"), camera.eye());
+  set_vec3(m.lit.uniform("u_light_pos"), m.room.light_position);
+  set_vec3(m.lit.uniform("u_light_dir"), (m.room.light_target - m.room.light_position).normalized());
+  glUniform1i(m.lit.uniform("u_shadows"), options.shadows ? 1 : 0);
+  glUniform1f(m.lit.uniform("u_shadow_radius"), kShadowRadius);
+  glUniform2f(m.lit.uniform("u_corner"), static_cast<float>(m.room.floor_y), static_cast<float>(m.room.wall_z));
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, options.shadows ? m.shadow_texture : 0);
+  glUniform1i(m.lit.uniform("u_shadow_map"), 0);
+
+  // The mobile first: it hides part of the room, so fewer room pixels get shaded.
+  glDisable(GL_CULL_FACE);
+  glUniform2f(m.lit.uniform("u_material"), kMobileSpecular, kMobileShininess);
+  glUniform1i(m.lit.uniform("u_room"), 0);
+  m.draw_mobile(m.lit, state, true, options.highlighted);
+
+  if (options.room) {
+    glEnable(GL_CULL_FACE);  // from behind the wall or below the floor, see through them
+    glCullFace(GL_BACK);
+    glBindVertexArray(m.room_vao);
+    set_mat4(m.lit.uniform("u_model"), Mat4f::Identity());
+    glUniform2f(m.lit.uniform("u_material"), kRoomSpecular, kRoomShininess);
+    glUniform1i(m.lit.uniform("u_room"), 1);
+    glUniform1f(m.lit.uniform("u_highlight"), 0.0f);
+    glUniform3fv(m.lit.uniform("u_color"), 1, kFloorColor);
+    glDrawArrays(GL_TRIANGLES, 0, 6);
+    glUniform3fv(m.lit.uniform("u_color"), 1, kWallColor);
+    glDrawArrays(GL_TRIANGLES, 6, 6);
+    glDisable(GL_CULL_FACE);
+  }
+
+  // 3. Overlay lines.
+  if (!lines.empty()) {
+    m.line.use();
+    set_mat4(m.line.uniform("u_view_proj"), view_proj);
+    glBindVertexArray(m.line_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, m.line_vbo);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    for (const LineSet& set : lines) {
+      if (set.points.size() < 2) continue;
+      std::vector<float> data;
+      data.reserve(set.points.size() * 3);
+      for (const Vec3& p : set.points)
+        data.insert(data.end(), {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(), GL_STREAM_DRAW);
+      glUniform4fv(m.line.uniform("u_color"), 1, set.color.data());
+      glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(set.points.size() / 2 * 2));
+    }
+    glDisable(GL_BLEND);
+  }
+  glBindVertexArray(0);
+  glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+}  // namespace aloft::render

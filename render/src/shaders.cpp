@@ -1,0 +1,120 @@
+#include "shaders.hpp"
+
+namespace aloft::render::shaders {
+
+std::string glsl_source(const char* body, bool gles) {
+  std::string s = gles ? "#version 300 es\nprecision highp float;\nprecision highp sampler2DShadow;\n"
+                       : "#version 330 core\n";
+  return s + body;
+}
+
+// Lit surfaces (mobile and room). Positions in the model's frame, u_model to world.
+const char* const kLitVertex = R"(
+in vec3 a_position;
+in vec3 a_normal;
+uniform mat4 u_model;
+uniform mat4 u_view_proj;
+uniform mat4 u_light_view_proj;
+out vec3 v_world;
+out vec3 v_normal;
+out vec4 v_light_clip;
+void main() {
+  vec4 world = u_model * vec4(a_position, 1.0);
+  v_world = world.xyz;
+  v_normal = mat3(u_model) * a_normal;   // rigid transforms only: no inverse-transpose needed
+  // Normal-offset shadow lookup: a few millimetres off the surface, against self-shadowing grain.
+  v_light_clip = u_light_view_proj * (world + vec4(normalize(v_normal) * 0.004, 0.0));
+  gl_Position = u_view_proj * world;
+}
+)";
+
+// One warm key spot light with a soft shadow (percentage-closer filtering over a rotated Poisson disc,
+// each tap a hardware 2x2 comparison), a sky/ground hemisphere fill, Blinn-Phong highlights, and a
+// darkening near the floor-wall corner. Colours are given as sRGB and lit in linear space.
+const char* const kLitFragment = R"(
+in vec3 v_world;
+in vec3 v_normal;
+in vec4 v_light_clip;
+uniform vec3 u_color;            // sRGB 0..1
+uniform vec3 u_eye;              // world, m
+uniform vec3 u_light_pos;        // world, m
+uniform vec3 u_light_dir;        // unit, the spot's axis
+uniform sampler2DShadow u_shadow_map;
+uniform int u_shadows;           // 0 or 1
+uniform float u_shadow_radius;   // PCF radius, shadow-map texture units
+uniform vec2 u_material;         // specular strength, shininess
+uniform float u_highlight;       // 0..1: tint towards a warm glow (the grabbed component)
+uniform vec2 u_corner;           // floor height y and wall plane z (m), for the corner darkening
+uniform int u_room;              // 1 on the floor and the wall
+layout(location = 0) out vec4 o_color;
+
+const vec2 kDisc[8] = vec2[8](vec2(-0.613, 0.354), vec2(0.170, -0.704), vec2(0.707, 0.380),
+    vec2(-0.282, -0.338), vec2(0.297, 0.176), vec2(-0.902, -0.256), vec2(0.088, 0.952), vec2(0.689, -0.598));
+
+float lit_fraction() {
+  if (u_shadows == 0) return 1.0;
+  vec3 p = v_light_clip.xyz / v_light_clip.w * 0.5 + 0.5;
+  if (v_light_clip.w <= 0.0 || p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
+  p.z = min(p.z, 1.0);   // receivers beyond the far plane (the wall) still compare against casters
+  // A per-pixel rotation of the disc turns banding into fine noise that the eye reads as softness.
+  float a = fract(sin(dot(gl_FragCoord.xy, vec2(12.9898, 78.233))) * 43758.5453) * 6.2831853;
+  mat2 rot = mat2(cos(a), sin(a), -sin(a), cos(a));
+  float sum = 0.0;
+  for (int i = 0; i < 8; ++i)
+    sum += texture(u_shadow_map, vec3(p.xy + rot * kDisc[i] * u_shadow_radius, p.z));
+  return sum / 8.0;
+}
+
+void main() {
+  vec3 base = pow(u_color, vec3(2.2));
+  vec3 n = normalize(v_normal);
+  vec3 v = normalize(u_eye - v_world);
+  if (dot(n, v) < 0.0) n = -n;           // thin sheets seen from behind
+  vec3 to_light = u_light_pos - v_world;
+  float dist = length(to_light);
+  vec3 l = to_light / dist;
+  float spot = smoothstep(0.45, 0.97, dot(-l, u_light_dir));   // a gallery spot: a soft pool of light
+  float diffuse = max(dot(n, l), 0.0);
+  vec3 h = normalize(l + v);
+  float spec = u_material.x * pow(max(dot(n, h), 0.0), u_material.y) * step(0.0, dot(n, l));
+  float shadow = (diffuse > 0.0 && spot > 0.0) ? lit_fraction() : 1.0;
+  vec3 key = vec3(1.0, 0.95, 0.86) * 1.25 * spot * shadow;
+  float sky = 0.5 + 0.5 * n.y;
+  vec3 ambient = mix(vec3(0.15, 0.14, 0.13), vec3(0.30, 0.31, 0.34), sky);
+  if (u_room == 1) {
+    // Light gathers less in the corner where the floor meets the wall.
+    float d = min(v_world.y - u_corner.x, v_world.z - u_corner.y);
+    ambient *= 1.0 - 0.45 * exp(-d / 0.35);
+  }
+  vec3 color = base * (ambient + key * diffuse) + key * spec;
+  color = mix(color, vec3(1.0, 0.62, 0.2), 0.45 * u_highlight);
+  color = color / (1.0 + 0.15 * color);  // gentle roll-off of highlights
+  o_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
+}
+)";
+
+const char* const kDepthVertex = R"(
+in vec3 a_position;
+uniform mat4 u_model;
+uniform mat4 u_light_view_proj;
+void main() { gl_Position = u_light_view_proj * u_model * vec4(a_position, 1.0); }
+)";
+
+const char* const kDepthFragment = R"(
+layout(location = 0) out vec4 o_color;
+void main() { o_color = vec4(1.0); }
+)";
+
+const char* const kLineVertex = R"(
+in vec3 a_position;
+uniform mat4 u_view_proj;
+void main() { gl_Position = u_view_proj * vec4(a_position, 1.0); }
+)";
+
+const char* const kLineFragment = R"(
+uniform vec4 u_color;   // sRGB, alpha
+layout(location = 0) out vec4 o_color;
+void main() { o_color = u_color; }
+)";
+
+}  // namespace aloft::render::shaders

@@ -1,0 +1,19 @@
+#pragma once
+// GLSL sources, written in the common subset of GLSL 3.30 core and GLSL ES 3.00 (WebGL2): the version
+// line (and ES precision qualifiers) are prepended by glsl_source().
+
+#include <string>
+
+namespace aloft::render::shaders {
+
+// "#version 330 core" or "#version 300 es" + precisions, then `body`.
+std::string glsl_source(const char* body, bool gles);
+
+extern const char* const kLitVertex;
+extern const char* const kLitFragment;
+extern const char* const kDepthVertex;
+extern const char* const kDepthFragment;
+extern const char* const kLineVertex;
+extern const char* const kLineFragment;
+
+}  // namespace aloft::render::shaders
