@@ -1,0 +1,122 @@
+#include "dynamics/contact_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace aloft {
+
+namespace {
+
+// Gauss-Seidel stops when no impulse changed by more than this fraction of the largest impulse; a
+// single contact is exact after one pass (checked by the second).
+constexpr double kRelativeChange = 1e-13;
+constexpr int kMaxSweeps = 200;
+// A slip speed (m/s) below this has no reliable direction; the sticking impulse's direction is used.
+constexpr double kSlipDirectionFloor = 1e-9;
+
+using Vec3d = Eigen::Vector3d;
+using Mat3d = Eigen::Matrix3d;
+
+// The impulse of one contact (in its basis) given the velocity it would have without its own impulse.
+Vec3d contact_impulse(const Mat3d& K, const Vec3d& u_free, const ContactLawRow& row, bool* sliding) {
+  *sliding = false;
+  const double knn = K(0, 0);
+  if (!(knn > 0)) return Vec3d::Zero();                // nothing can move at this point
+  if (u_free.x() >= row.target_normal) return Vec3d::Zero();  // separating fast enough: no impulse
+
+  // Mirtich's prediction: the impulse that makes the contact stick (normal target met, no slip).
+  const Vec3d wanted(row.target_normal, 0, 0);
+  const Vec3d stick = K.ldlt().solve(wanted - u_free);
+  const double tangential = stick.tail<2>().norm();
+  if (std::isfinite(tangential) && stick.x() > 0 && tangential <= row.friction * stick.x()) return stick;
+
+  // Sliding: P = P_n (n - mu s) with s the slip direction, on the cone's edge.
+  Eigen::Vector2d slip = u_free.tail<2>();
+  if (slip.norm() > kSlipDirectionFloor) {
+    slip.normalize();
+  } else if (std::isfinite(tangential) && tangential > 0) {
+    slip = -stick.tail<2>() / tangential;  // friction must push the way sticking would
+  } else {
+    slip.setZero();
+  }
+  const Vec3d direction(1.0, -row.friction * slip.x(), -row.friction * slip.y());
+  const double denominator = (K * direction).x();
+  // When friction along the fixed direction would need a negative push (a jam), fall back to a
+  // frictionless normal impulse, which always exists.
+  if (denominator > 1e-9 * knn) {
+    const double pn = (row.target_normal - u_free.x()) / denominator;
+    if (pn > 0) {
+      *sliding = row.friction > 0 && slip.squaredNorm() > 0;
+      return pn * direction;
+    }
+  }
+  return Vec3d((row.target_normal - u_free.x()) / knn, 0, 0);
+}
+
+}  // namespace
+
+ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
+                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P) {
+  const int m = static_cast<int>(rows.size());
+  ContactLawResult result;
+  P.setZero(3 * m);
+  if (m == 0) return result;
+  Eigen::VectorXd velocity = u;  // u + K P, kept current
+  std::vector<char> sliding(m, 0);
+  for (int sweep = 1; sweep <= kMaxSweeps; ++sweep) {
+    result.iterations = sweep;
+    double largest_change = 0, largest_impulse = 0;
+    for (int k = 0; k < m; ++k) {
+      const Mat3d Kkk = K.block<3, 3>(3 * k, 3 * k);
+      const Vec3d old = P.segment<3>(3 * k);
+      const Vec3d u_free = velocity.segment<3>(3 * k) - Kkk * old;
+      bool slides = false;
+      const Vec3d next = contact_impulse(Kkk, u_free, rows[k], &slides);
+      sliding[k] = slides;
+      const Vec3d change = next - old;
+      if (change.squaredNorm() > 0) {
+        velocity.noalias() += K.middleCols<3>(3 * k) * change;
+        P.segment<3>(3 * k) = next;
+      }
+      largest_change = std::max(largest_change, change.cwiseAbs().maxCoeff());
+      largest_impulse = std::max(largest_impulse, next.cwiseAbs().maxCoeff());
+    }
+    if (m == 1 || largest_change <= kRelativeChange * largest_impulse) break;
+  }
+  for (int k = 0; k < m; ++k) {
+    if (!(P[3 * k] > 0)) continue;
+    if (sliding[k]) ++result.sliding;
+    else ++result.sticking;
+  }
+  result.energy_change = contact_energy_change(K, u, P);
+  return result;
+}
+
+void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,
+                      Eigen::VectorXd& P_n) {
+  const int m = static_cast<int>(u_n.size());
+  P_n.setZero(m);
+  Eigen::VectorXd velocity = u_n;
+  for (int sweep = 1; sweep <= kMaxSweeps; ++sweep) {
+    double largest_change = 0, largest_impulse = 0;
+    for (int k = 0; k < m; ++k) {
+      const double kkk = K_nn(k, k);
+      if (!(kkk > 0)) continue;
+      const double next = std::max(0.0, P_n[k] + (target[k] - velocity[k]) / kkk);
+      const double change = next - P_n[k];
+      if (change != 0) {
+        velocity.noalias() += K_nn.col(k) * change;
+        P_n[k] = next;
+      }
+      largest_change = std::max(largest_change, std::abs(change));
+      largest_impulse = std::max(largest_impulse, next);
+    }
+    if (m == 1 || largest_change <= kRelativeChange * largest_impulse) break;
+  }
+}
+
+double contact_energy_change(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const Eigen::VectorXd& P) {
+  return u.dot(P) + 0.5 * P.dot(K * P);
+}
+
+}  // namespace aloft

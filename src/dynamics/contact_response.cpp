@@ -1,0 +1,168 @@
+#include "dynamics/contact_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "aloft/model.hpp"
+
+namespace aloft {
+
+namespace {
+
+// An orthonormal basis (n, t1, t2) as matrix columns, t1 chosen away from n's largest component.
+Mat3 contact_basis(const Vec3& n) {
+  const Vec3 helper = std::abs(n.x()) < 0.6 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 t1 = (helper - n.dot(helper) * n).normalized();
+  Mat3 basis;
+  basis.col(0) = n;
+  basis.col(1) = t1;
+  basis.col(2) = n.cross(t1);
+  return basis;
+}
+
+}  // namespace
+
+ContactResponse::ContactResponse(const Model& model)
+    : model_(model),
+      wrench_(model.count, Vec6::Zero()),
+      zero_rows_(model.count, Vec3::Zero()),
+      du_(model.count, Vec6::Zero()),
+      lambda_(model.count, Vec3::Zero()) {}
+
+void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P, bool lambda) {
+  const int m = static_cast<int>(contacts.size());
+  for (int k = 0; k < m; ++k) {
+    const Vec3 impulse = basis_[k] * P.segment<3>(3 * k);
+    const Contact& c = contacts[k];
+    wrench_[c.a].head<3>() += impulse;
+    wrench_[c.a].tail<3>() += arm_a_[k].cross(impulse);
+    wrench_[c.b].head<3>() -= impulse;
+    wrench_[c.b].tail<3>() -= arm_b_[k].cross(impulse);
+  }
+  // The solver ignores body 0 (fixed) and keeps every joint's velocity constraint (c = 0).
+  wrench_[0].setZero();
+  // (Only the bodies touched above are non-zero; reset them after the solve.)
+  solver_->solve(wrench_, zero_rows_, du_, lambda ? &lambda_ : nullptr);
+  for (const Contact& c : contacts) {
+    wrench_[c.a].setZero();
+    wrench_[c.b].setZero();
+  }
+}
+
+ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
+                                           const std::vector<Contact>& contacts, double h,
+                                           std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
+                                           std::vector<Vec6>& pseudo, bool& has_pseudo) {
+  ContactStepReport report;
+  has_pseudo = false;
+  const int m = static_cast<int>(contacts.size());
+  report.contacts = m;
+  if (m == 0) return report;
+  solver_ = &solver;
+
+  // Contact frames, lever arms and the velocities before the impulse (a relative to b, contact basis).
+  basis_.resize(m);
+  arm_a_.resize(m);
+  arm_b_.resize(m);
+  rows_.resize(m);
+  u_.resize(3 * m);
+  auto point_velocity = [&](int body, const Vec3& arm) -> Vec3 {
+    return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
+  };
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = contacts[k];
+    basis_[k] = contact_basis(c.normal);
+    arm_a_[k] = c.point - pose.position[c.a];
+    arm_b_[k] = c.point - pose.position[c.b];
+    u_.segment<3>(3 * k) = basis_[k].transpose() * (point_velocity(c.a, arm_a_[k]) - point_velocity(c.b, arm_b_[k]));
+    rows_[k].friction = 0.5 * (model_.friction[c.a] + model_.friction[c.b]);
+    report.deepest = std::max(report.deepest, -c.distance);
+  }
+
+  // The collision matrix, one column per unit impulse along a contact's basis vector.
+  K_.resize(3 * m, 3 * m);
+  Eigen::VectorXd unit = Eigen::VectorXd::Zero(3 * m);
+  for (int col = 0; col < 3 * m; ++col) {
+    unit[col] = 1;
+    respond(contacts, unit, false);
+    unit[col] = 0;
+    for (int k = 0; k < m; ++k) {
+      const Contact& c = contacts[k];
+      auto moved = [&](int body, const Vec3& arm) -> Vec3 {
+        return body == 0 ? Vec3::Zero() : Vec3(du_[body].head<3>() + du_[body].tail<3>().cross(arm));
+      };
+      K_.block<3, 1>(3 * k, col) = basis_[k].transpose() * (moved(c.a, arm_a_[k]) - moved(c.b, arm_b_[k]));
+    }
+  }
+  K_ = (0.5 * (K_ + K_.transpose())).eval();  // symmetric up to round-off; make it exactly so
+
+  // Targets: bounce what collides fast within this step; let the rest close their gap but not pass it.
+  const double threshold = std::max(tuning.bounce_threshold, 2.0 * model_.gravity.norm() * h);
+  bool any_bounce = false;
+  auto set_targets = [&](bool restitution) {
+    for (int k = 0; k < m; ++k) {
+      const Contact& c = contacts[k];
+      const double un = u_[3 * k];
+      const double e = 0.5 * (model_.restitution[c.a] + model_.restitution[c.b]);
+      const bool collides = un < -threshold && c.distance + un * h <= 0;
+      rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
+      if (restitution && collides && e > 0) {
+        rows_[k].target_normal = -e * un;
+        any_bounce = true;
+      }
+    }
+  };
+  set_targets(true);
+  ContactLawResult law = solve_contact_law(K_, u_, rows_, P_);
+  // Energy may only leave: allow round-off relative to the energies the impulses exchange.
+  const auto gained = [&](const ContactLawResult& r) {
+    const double scale = std::abs(u_.dot(P_)) + 1e-300;
+    return r.energy_change > 1e-10 * scale;
+  };
+  if (any_bounce && gained(law)) {
+    set_targets(false);
+    law = solve_contact_law(K_, u_, rows_, P_);
+    report.restitution_dropped = true;
+  }
+  report.iterations = law.iterations;
+  report.sticking = law.sticking;
+  report.sliding = law.sliding;
+  report.energy_change = law.energy_change;
+  for (int k = 0; k < m; ++k) report.active += P_[3 * k] > 0;
+
+  // Apply: one tree solve with G^T P gives every body's velocity change and the joint impulses.
+  if (report.active > 0) {
+    respond(contacts, P_, true);
+    for (int i = 1; i < model_.count; ++i) {
+      velocity[i] += du_[i].head<3>();
+      angular[i] += du_[i].tail<3>();
+    }
+  } else {
+    std::fill(lambda_.begin(), lambda_.end(), Vec3::Zero());
+  }
+
+  // Split impulse: a frictionless pseudo-velocity that removes a part of each overlap beyond the slop.
+  bool penetrating = false;
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(m), un = Eigen::VectorXd::Zero(m), Pn;
+  for (int k = 0; k < m; ++k) {
+    const double overlap = -contacts[k].distance - tuning.penetration_slop;
+    if (overlap > 0) {
+      target[k] = tuning.penetration_rate * overlap / h;
+      penetrating = true;
+    }
+  }
+  if (penetrating) {
+    Eigen::MatrixXd Knn(m, m);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < m; ++j) Knn(i, j) = K_(3 * i, 3 * j);
+    solve_normal_law(Knn, un, target, Pn);
+    Eigen::VectorXd P = Eigen::VectorXd::Zero(3 * m);
+    for (int k = 0; k < m; ++k) P[3 * k] = Pn[k];
+    respond(contacts, P, false);
+    for (int i = 0; i < model_.count; ++i) pseudo[i] = i == 0 ? Vec6::Zero() : du_[i];
+    has_pseudo = true;
+  }
+  return report;
+}
+
+}  // namespace aloft

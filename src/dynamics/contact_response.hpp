@@ -1,0 +1,94 @@
+#pragma once
+// Collision response solved together with the joints (method notes section 5; Moore & Wilhelms 1988,
+// Mirtich 1996), in time linear in the number of components.
+//
+// At a collision the velocities jump. The unknowns are the new velocities of every moving component,
+// the contact impulses P and the joint impulses; the equations are momentum for every component, the
+// joints' velocity constraints, and the contact law. That is the velocity-level tree system of section
+// 3 with the contact rows as auxiliary rows. Its Schur complement on the contact rows is the collision
+// matrix K = G H^-1 G^T (3 rows per contact), whose columns are tree solves with unit contact impulses:
+// 3m solves of O(n) each for m contacts. The contact law (dynamics/contact_law.hpp) then gives P, and
+// one more tree solve with G^T P gives every component's velocity change and the joint impulses — so
+// one knock moves the whole chain the way a real mobile does.
+//
+// Contacts are speculative (the detector reports pairs closer than the distance they can close in one
+// step). Per contact, with d the signed gap and u_n the normal approach velocity:
+//   * colliding within this step, faster than the bounce threshold: u_n' >= -e u_n (restitution);
+//   * otherwise: u_n' >= -max(d, 0) / h, the contact may close its gap but not pass it.
+// Penetration (d < 0, from round-off or a resting contact settling) is pushed out by a separate
+// frictionless "pseudo-velocity" that moves positions in this step's drift only and is then forgotten
+// (split impulse), so correcting it adds no kinetic energy.
+// If the Newton restitution targets would add kinetic energy (possible with sticking friction and
+// several contacts), the step's impulses are recomputed with e = 0, which only removes energy.
+
+#include <vector>
+
+#include "aloft/collision.hpp"
+#include "dynamics/contact_law.hpp"
+#include "dynamics/tree_solver.hpp"
+
+namespace aloft {
+
+struct ContactTuning {
+  // Normal approach speeds (m/s) below this are not bounced: a resting contact under gravity approaches
+  // at about g h per step, and bouncing it would make it chatter. Raised to 2 g h at run time.
+  double bounce_threshold = 0.005;
+  double penetration_slop = 5e-5;  // m: overlap tolerated without correction (round-off, settling)
+  double penetration_rate = 0.2;   // fraction of the overlap beyond the slop removed per step
+};
+
+// What the last resolve did (for statistics, the viewer and tests).
+struct ContactStepReport {
+  int contacts = 0;            // speculative contacts considered
+  int active = 0;              // contacts that received an impulse
+  int sticking = 0;
+  int sliding = 0;
+  int iterations = 0;          // Gauss-Seidel sweeps of the contact law
+  bool restitution_dropped = false;  // Newton restitution would have added energy: solved with e = 0
+  double energy_change = 0;    // J, kinetic energy the impulses changed (<= 0 up to round-off)
+  double deepest = 0;          // m, largest overlap among the contacts (>= 0)
+};
+
+class ContactResponse {
+ public:
+  explicit ContactResponse(const Model& model);
+
+  // Resolve `contacts` (detected at `pose`, the pose `solver` is factored at) against the velocities
+  // `velocity`/`angular` (world, changed in place). joint_impulses() then holds the joint impulses the
+  // contact impulses caused (per joint, N s, on the child). They are not added to the step's joint
+  // impulses used for the next step's warm start: contacts are re-solved every step. `pseudo` (per body: linear m/s, angular rad/s) is
+  // set to the penetration-removing pseudo-velocity; `has_pseudo` says whether it is non-zero.
+  ContactStepReport resolve(const State& pose, TreeSolver& solver, const std::vector<Contact>& contacts, double h,
+                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
+                            bool& has_pseudo);
+
+  ContactTuning tuning;
+
+  // The collision matrix and pre-impulse contact velocities of the last resolve (contact bases), for
+  // tests.
+  const Eigen::MatrixXd& collision_matrix() const { return K_; }
+  const Eigen::VectorXd& contact_velocity() const { return u_; }
+  const Eigen::VectorXd& impulses() const { return P_; }
+  const std::vector<Vec3>& joint_impulses() const { return lambda_; }
+  // Orthonormal basis (n, t1, t2) of contact k, as matrix columns.
+  const Mat3& basis(int k) const { return basis_[k]; }
+
+ private:
+  // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_ (and
+  // lambda_ when `lambda` is true).
+  void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P, bool lambda);
+
+  const Model& model_;
+  TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose
+  std::vector<Mat3> basis_;
+  std::vector<Vec3> arm_a_, arm_b_;  // centre of mass of a (b) -> contact point, world, m
+  std::vector<ContactLawRow> rows_;
+  Eigen::MatrixXd K_;
+  Eigen::VectorXd u_, P_;
+  std::vector<Vec6> wrench_;   // per body, zero between uses
+  std::vector<Vec3> zero_rows_;
+  std::vector<Vec6> du_;
+  std::vector<Vec3> lambda_;
+};
+
+}  // namespace aloft

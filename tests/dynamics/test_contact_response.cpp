@@ -1,0 +1,235 @@
+// Contact impulses solved together with the joints: against a dense solve of Moore & Wilhelms' system
+// (momentum, joint velocity constraints and the contact law as one linear system), and energy/cone
+// bounds on random trees.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cstdlib>
+#include <random>
+
+#include "dynamics/contact_response.hpp"
+#include "dynamics/tree_solver.hpp"
+#include "support/model_builder.hpp"
+
+namespace aloft {
+namespace {
+
+// A chain of `count - 1` random bodies hanging from a nail on component 0.
+Model random_chain(int count, unsigned seed) {
+  std::srand(seed);
+  Model m = test::random_tree(count, seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (int i = 1; i < count; ++i) {
+    m.parent[i] = i - 1;
+    m.joint_world[i] = m.rest_position[i - 1] + Vec3(u(rng), u(rng), u(rng));
+    m.rest_position[i] = m.joint_world[i] + Vec3(u(rng), -0.3, u(rng));
+  }
+  test::finish_model(m);
+  return m;
+}
+
+// Random velocities that satisfy every joint: a random momentum projected through the tree solve.
+void random_consistent_velocities(const Model& model, TreeSolver& solver, unsigned seed, State& state) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<Vec6> f(model.count, Vec6::Zero()), u(model.count, Vec6::Zero());
+  std::vector<Vec3> c(model.count, Vec3::Zero());
+  for (int i = 1; i < model.count; ++i)
+    for (int k = 0; k < 6; ++k) f[i](k) = g(rng);
+  solver.solve(f, c, u);
+  for (int i = 1; i < model.count; ++i) {
+    state.velocity[i] = u[i].head<3>();
+    state.angular[i] = u[i].tail<3>();
+  }
+}
+
+// A contact on body b (against a, possibly the fixed component 0) at a point near b, with a normal chosen
+// so that the two approach.
+Contact approaching_contact(const State& state, int a, int b, const Vec3& offset, const Vec3& direction) {
+  Contact c;
+  c.a = a;
+  c.b = b;
+  c.point = state.position[b] + offset;
+  c.normal = direction.normalized();
+  c.distance = 0;
+  auto point_velocity = [&](int i) {
+    return i == 0 ? Vec3::Zero() : Vec3(state.velocity[i] + state.angular[i].cross(c.point - state.position[i]));
+  };
+  if (c.normal.dot(point_velocity(a) - point_velocity(b)) > 0) c.normal = -c.normal;
+  return c;
+}
+
+// Moore's system, densely: unknowns [u'; -lambda; -P] with
+//   M u' + J^T(-lambda) + G^T(-P) = M u,    J u' = 0,    G u' = target,
+// G the rows of the contact law: sticking (normal and both tangents, rows = 3) or frictionless (the
+// normal only, rows = 1).
+void dense_moore(const Model& model, const State& state, const Contact& c, const Mat3& basis, int rows,
+                 const Eigen::Vector3d& target, Eigen::VectorXd& u_after, Eigen::Vector3d& P) {
+  const int m = model.count - 1;
+  const Eigen::MatrixXd H = dense_kkt_matrix(model, state);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(9 * m + rows, 9 * m + rows);
+  A.topLeftCorner(9 * m, 9 * m) = H;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(rows, 9 * m);
+  auto add_body = [&](int body, double sign) {
+    if (body == 0) return;
+    Eigen::Matrix<double, 3, 6> row;
+    row << Mat3::Identity(), -skew(c.point - state.position[body]);
+    G.block(0, 6 * (body - 1), rows, 6) += sign * (basis.transpose() * row).topRows(rows);
+  };
+  add_body(c.a, +1);
+  add_body(c.b, -1);
+  A.block(9 * m, 0, rows, 9 * m) = G;
+  A.block(0, 9 * m, 9 * m, rows) = G.transpose();
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(9 * m + rows);
+  for (int i = 1; i < model.count; ++i) {
+    rhs.segment<3>(6 * (i - 1)) = H.block<3, 3>(6 * (i - 1), 6 * (i - 1)) * state.velocity[i];
+    rhs.segment<3>(6 * (i - 1) + 3) = H.block<3, 3>(6 * (i - 1) + 3, 6 * (i - 1) + 3) * state.angular[i];
+  }
+  rhs.tail(rows) = target.head(rows);
+  const Eigen::VectorXd x = A.fullPivLu().solve(rhs);
+  u_after = x.head(6 * m);
+  P.setZero();
+  P.head(rows) = -x.tail(rows);
+}
+
+// Returns false (nothing compared) when the law's answer is not the sticking one Moore's linear system
+// describes: in an articulated chain, stopping the slip can need a pull (P_n < 0), and then the contact
+// slides. friction = 0 compares the frictionless law.
+bool check_chain_against_moore(int count, unsigned seed, int a, double restitution, double friction) {
+  Model model = random_chain(count, seed);
+  model.restitution.assign(count, restitution);
+  model.friction.assign(count, friction);
+  State state = rest_state(model);
+  TreeSolver solver(model);
+  solver.factor(state);
+  random_consistent_velocities(model, solver, seed + 7, state);
+  const int b = count - 1;
+  const Contact contact = approaching_contact(state, a, b, Vec3(0.05, -0.1, 0.02), Vec3(0.3, 1, -0.2));
+
+  ContactResponse response(model);
+  response.tuning.bounce_threshold = 0;  // bounce at any speed: the test compares the law itself
+  std::vector<Vec3> v = state.velocity, w = state.angular;
+  std::vector<Vec6> pseudo(count, Vec6::Zero());
+  bool has_pseudo = false;
+  const double h = 1e-3;
+  const ContactStepReport report = response.resolve(state, solver, {contact}, h, v, w, pseudo, has_pseudo);
+  EXPECT_EQ(report.active, 1);
+  if (friction > 0 && report.sticking != 1) return false;
+  const double un = response.contact_velocity()[0];
+  Eigen::VectorXd u_after;
+  Eigen::Vector3d P;
+  // Sticking with Newton's restitution can add energy in an articulated system (Kane's kind of paradox);
+  // the response then solves with e = 0, and so must the reference.
+  const double e = report.restitution_dropped ? 0.0 : restitution;
+  dense_moore(model, state, contact, response.basis(0), friction > 0 ? 3 : 1, Eigen::Vector3d(-e * un, 0, 0),
+              u_after, P);
+
+  // Both solve the same linear system (one by tree elimination with the collision matrix, one densely
+  // with full pivoting): agreement to 1e-9 relative, as for the joint solve alone.
+  const Eigen::Vector3d ours = response.impulses().head<3>();
+  EXPECT_LT((ours - P).norm(), 1e-9 * P.norm()) << "seed " << seed << " friction " << friction << ": ours " << ours.transpose() << ", dense "
+      << P.transpose() << (report.restitution_dropped ? " (restitution dropped)" : "");
+  double scale = 0, error = 0;
+  for (int i = 1; i < count; ++i) {
+    scale = std::max(scale, u_after.segment<6>(6 * (i - 1)).cwiseAbs().maxCoeff());
+    error = std::max(error, (v[i] - u_after.segment<3>(6 * (i - 1))).cwiseAbs().maxCoeff());
+    error = std::max(error, (w[i] - u_after.segment<3>(6 * (i - 1) + 3)).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(error, 1e-9 * scale);
+  return true;
+}
+
+TEST(ContactResponse, ChainAgainstTheHookMatchesMooresDenseSystem) {
+  int compared = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    compared += check_chain_against_moore(6, seed, 0, 0.5, 50.0);
+    check_chain_against_moore(6, seed, 0, 0.5, 0.0);
+  }
+  EXPECT_GE(compared, 5);  // sticking happened often enough to be compared
+}
+
+TEST(ContactResponse, TwoLinksOfOneChainMatchMooresDenseSystem) {
+  int compared = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    compared += check_chain_against_moore(8, seed, 2, 0.8, 50.0);
+    check_chain_against_moore(8, seed, 2, 0.8, 0.0);
+  }
+  EXPECT_GE(compared, 3);
+}
+
+TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
+  int sliding = 0;
+  for (unsigned seed = 1; seed <= 60; ++seed) {
+    std::srand(seed);
+    Model model = test::random_tree(12, seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    model.restitution.assign(model.count, unit(rng));
+    model.friction.assign(model.count, 1.2 * unit(rng));
+    State state = rest_state(model);
+    TreeSolver solver(model);
+    solver.factor(state);
+    random_consistent_velocities(model, solver, seed + 3, state);
+    // Three simultaneous contacts between random bodies (or against the hook).
+    std::vector<Contact> contacts;
+    for (int k = 0; k < 3; ++k) {
+      int a = static_cast<int>(unit(rng) * model.count), b = static_cast<int>(unit(rng) * model.count);
+      if (a == b) b = (b + 1) % model.count;
+      if (a > b) std::swap(a, b);
+      contacts.push_back(approaching_contact(state, a, b, 0.1 * Vec3::Random(), Vec3::Random()));
+    }
+    const double before = kinetic_energy(model, state);
+    ContactResponse response(model);
+    response.tuning.bounce_threshold = 0;
+    State after = state;
+    std::vector<Vec6> pseudo(model.count, Vec6::Zero());
+    bool has_pseudo = false;
+    const ContactStepReport report =
+        response.resolve(state, solver, contacts, 1e-3, after.velocity, after.angular, pseudo, has_pseudo);
+    sliding += report.sliding;
+    // Energy only leaves (round-off of O(1) energies allowed).
+    EXPECT_LE(kinetic_energy(model, after), before * (1 + 1e-10)) << "seed " << seed;
+    const Eigen::VectorXd& P = response.impulses();
+    for (int k = 0; k < 3; ++k) {
+      const double mu = model.friction[contacts[k].a];
+      EXPECT_GE(P[3 * k], 0.0);
+      EXPECT_LE(P.segment<2>(3 * k + 1).norm(), mu * P[3 * k] * (1 + 1e-12) + 1e-15);
+    }
+    // The joints still move together: the impulse went through the joint rows too.
+    for (int i = 1; i < model.count; ++i) {
+      const int p = model.parent[i];
+      const Vec3 r = state.orientation[i] * model.joint_in_child[i];
+      const Vec3 s = state.orientation[p] * model.joint_in_parent[i];
+      const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(after.velocity[p] + after.angular[p].cross(s));
+      // Relative 1e-9 of O(1) velocities, the tree solve's accuracy.
+      EXPECT_LT((after.velocity[i] + after.angular[i].cross(r) - vp).norm(), 1e-9);
+    }
+  }
+  EXPECT_GT(sliding, 5);  // the sliding branch was exercised
+}
+
+TEST(ContactResponse, OverlapIsPushedOutByAPseudoVelocityOnly) {
+  const Model model = random_chain(4, 3);
+  State state = rest_state(model);
+  TreeSolver solver(model);
+  solver.factor(state);
+  Contact c = approaching_contact(state, 0, 3, Vec3(0, -0.1, 0), Vec3::UnitY());
+  c.distance = -1e-3;  // 1 mm overlap, bodies at rest
+  ContactResponse response(model);
+  std::vector<Vec3> v = state.velocity, w = state.angular;
+  std::vector<Vec6> pseudo(model.count, Vec6::Zero());
+  bool has_pseudo = false;
+  response.resolve(state, solver, {c}, 1e-3, v, w, pseudo, has_pseudo);
+  ASSERT_TRUE(has_pseudo);
+  // The real velocities stay zero: no energy is added to push the overlap out.
+  for (int i = 1; i < model.count; ++i) EXPECT_EQ(v[i].norm() + w[i].norm(), 0.0);
+  // The pseudo-velocity separates the contact at the requested rate: rate * (overlap - slop) / h.
+  const Vec3 arm = c.point - state.position[3];
+  const double separating = -c.normal.dot(pseudo[3].head<3>() + pseudo[3].tail<3>().cross(arm));
+  const double expected = response.tuning.penetration_rate * (1e-3 - response.tuning.penetration_slop) / 1e-3;
+  EXPECT_NEAR(separating, expected, 1e-9 * expected);
+}
+
+}  // namespace
+}  // namespace aloft
