@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "aloft/collision.hpp"
 #include "aloft/model.hpp"
 #include "common.hpp"
 
@@ -29,7 +30,14 @@ std::vector<int> file_order(const Model& m) {
   return order;
 }
 
-std::string inspect_json(const Model& m) {
+// Pairs of components as pairs of names.
+nlohmann::ordered_json pair_names(const Model& m, const std::vector<std::pair<int, int>>& pairs) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const auto& [a, b] : pairs) list.push_back({m.names[a], m.names[b]});
+  return list;
+}
+
+std::string inspect_json(const Model& m, const CollisionPairs& pairs) {
   using json = nlohmann::ordered_json;
   auto vec = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
   json root;
@@ -62,10 +70,44 @@ std::string inspect_json(const Model& m) {
     components.push_back(std::move(c));
   }
   root["components"] = std::move(components);
+  root["collision_pairs"] = {{"total", pairs.total},
+                             {"pruned", pairs.total - pairs.candidate_count},
+                             {"remaining", pairs.candidate_count},
+                             {"joined", pairs.joined},
+                             {"never_touch", pairs.never_touch},
+                             {"touching_at_rest", pair_names(m, pairs.touching_at_rest)},
+                             {"candidates", pairs.listed ? pair_names(m, pairs.candidates)
+                                                         : nlohmann::ordered_json(nullptr)}};
   return root.dump(2) + "\n";
 }
 
-std::string inspect_text(const Model& m) {
+// The pruning result: counts, the pairs touching at rest and the pairs collision detection tests.
+std::string collision_text(const Model& m, const CollisionPairs& pairs) {
+  constexpr std::size_t kMaxListed = 100;  // a large mobile has thousands: --json lists them all
+  std::string out;
+  const long long kept = pairs.candidate_count;
+  out += format("\nCollision pairs: %lld of %lld pruned (%lld joined by a joint, %lld can never touch, %zu "
+                "touching at rest); %lld remain%s\n",
+                pairs.total - kept, pairs.total, pairs.joined, pairs.never_touch, pairs.touching_at_rest.size(),
+                kept, kept > 0 ? ":" : ".");
+  auto list = [&](const std::vector<std::pair<int, int>>& ps) {
+    for (std::size_t k = 0; k < ps.size() && k < kMaxListed; ++k)
+      out += "  " + m.names[ps[k].first] + "  --  " + m.names[ps[k].second] + "\n";
+    if (ps.size() > kMaxListed) out += format("  ... and %zu more (--json lists all)\n", ps.size() - kMaxListed);
+  };
+  if (pairs.listed) {
+    list(pairs.candidates);
+  } else {
+    out += format("  (not listed: more than %d components)\n", CollisionPairs::kListedComponents);
+  }
+  if (!pairs.touching_at_rest.empty()) {
+    out += "Touching in the designed pose (left out of collision detection):\n";
+    list(pairs.touching_at_rest);
+  }
+  return out;
+}
+
+std::string inspect_text(const Model& m, const CollisionPairs& pairs) {
   std::string out;
   out += "mobile      " + m.name + "\n";
   out += "file        " + m.file + "\n";
@@ -105,6 +147,7 @@ std::string inspect_text(const Model& m) {
                  fixed(q.w(), 6), fixed(q.x(), 6), fixed(q.y(), 6), fixed(q.z(), 6)});
   }
   out += inertia.str("  ");
+  out += collision_text(m, pairs);
   return out;
 }
 
@@ -125,11 +168,14 @@ Runner add_inspect(CLI::App& app) {
   sub->add_flag("--json", o->json,
                 "Print JSON instead of a table: {name, file, balance {mode, total_mass, max_imbalance, notes}, "
                 "components [{name, parent, fixed, mass, com, principal_moments, rest_orientation [w,x,y,z], "
-                "joint, ...}]} in SI units, full precision; parent and joint are null for the fixed component");
+                "joint, ...}], collision_pairs {total, pruned, remaining, joined, never_touch, touching_at_rest "
+                "[[a, b]...], candidates [[a, b]...] (null above 2048 components)}} in SI units, full precision; parent and joint are null for the fixed component");
   sub->footer(
       "Per component: mass, centre of mass, principal moments of inertia, rest orientation (the rotation\n"
       "from the principal frame to the world), parent and joint point; then the balance result (mode,\n"
-      "total mass, largest imbalance, notes). Components are listed in FILE order (the order of the\n"
+      "total mass, largest imbalance, notes); then the collision pairs: how many pairs of components\n"
+      "are pruned (joined by a joint, too far apart to ever touch, touching in the designed pose) and\n"
+      "which remain for collision detection. Components are listed in FILE order (the order of the\n"
       "file's \"components\" array). SI units, world frame, y up.\n"
       "\n"
       "Examples:\n"
@@ -137,7 +183,8 @@ Runner add_inspect(CLI::App& app) {
       "  aloft inspect random.json --json > random-inspect.json\n");
   return [o] {
     const Model model = load_mobile_as(o->file, o->balance);
-    const std::string text = o->json ? inspect_json(model) : inspect_text(model);
+    const CollisionPairs pairs = prune_pairs(model);
+    const std::string text = o->json ? inspect_json(model, pairs) : inspect_text(model, pairs);
     std::fwrite(text.data(), 1, text.size(), stdout);
     if (std::fflush(stdout) != 0) throw Failure("cannot write to standard output");
     return kExitOk;

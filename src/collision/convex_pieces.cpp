@@ -1,0 +1,207 @@
+// Convex pieces of the shapes of a component (body frame), their supports, farthest distances and
+// enclosing spheres. See convex_pieces.hpp for what each shape becomes and why.
+
+#include "collision/convex_pieces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "aloft/geometry.hpp"
+#include "common/overloaded.hpp"
+
+namespace aloft::internal {
+
+namespace {
+
+// Farthest distance from p to a disk of centre c, unit normal n and radius r: the farthest point is on
+// the rim, on the side opposite to p's offset within the disk's plane.
+double farthest_on_disk(const Vec3& p, const Vec3& c, const Vec3& n, double r) {
+  const Vec3 d = c - p;
+  const double along = d.dot(n);
+  const double across = (d - along * n).norm();
+  return std::hypot(along, across + r);
+}
+
+ConvexPiece polytope(int shape, std::vector<Vec3> vertices) {
+  ConvexPiece piece;
+  piece.kind = ConvexPiece::Kind::Polytope;
+  piece.shape = shape;
+  piece.vertices = std::move(vertices);
+  return piece;
+}
+
+// The enclosing sphere of a piece: centre at the middle of its axis-aligned bounds, radius the exact
+// farthest distance from there.
+Bounds set_bounds(ConvexPiece& piece) {
+  Bounds box;
+  switch (piece.kind) {
+    case ConvexPiece::Kind::Sphere:
+      box.add(piece.a - Vec3::Constant(piece.radius));
+      box.add(piece.a + Vec3::Constant(piece.radius));
+      break;
+    case ConvexPiece::Kind::Cylinder:
+      for (const Vec3& e : {piece.a, piece.b}) {
+        box.add(e - Vec3::Constant(piece.radius));
+        box.add(e + Vec3::Constant(piece.radius));
+      }
+      break;
+    case ConvexPiece::Kind::Polytope:
+      for (const Vec3& v : piece.vertices) box.add(v);
+      break;
+  }
+  piece.bound_center = 0.5 * (box.min + box.max);
+  piece.bound_radius = piece.farthest_distance(piece.bound_center);
+  return box;
+}
+
+void add_plate(int shape, const Plate& plate, std::vector<ConvexPiece>& out) {
+  const Vec3 half = 0.5 * plate.thickness * plate.normal();
+  for (const std::vector<int>& part : convex_decomposition(plate.points)) {
+    std::vector<Vec3> vertices;
+    vertices.reserve(2 * part.size());
+    for (int k : part) {
+      const Vec3 p = plate.to_world(plate.points[k]);  // "world" here is the body frame
+      vertices.push_back(p - half);
+      vertices.push_back(p + half);
+    }
+    out.push_back(polytope(shape, std::move(vertices)));
+  }
+}
+
+void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out) {
+  Vec3 centroid = Vec3::Zero();
+  for (const Vec3& v : mesh.vertices) centroid += v;
+  centroid /= static_cast<double>(std::max<std::size_t>(1, mesh.vertices.size()));
+  // Star-shaped about the centroid: strictly inside every face plane (outward, counter-clockwise faces),
+  // by more than round-off relative to the face.
+  bool star = true;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    const Vec3 n = (b - a).cross(c - a);
+    if (!(n.dot(centroid - a) < -1e-9 * n.norm() * (b - a).norm())) {
+      star = false;
+      break;
+    }
+  }
+  for (const auto& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    if (star) {
+      out.push_back(polytope(shape, {a, b, c, centroid}));
+    } else {
+      const Vec3 inward = -kShellThickness * (b - a).cross(c - a).normalized();
+      out.push_back(polytope(shape, {a, b, c, a + inward, b + inward, c + inward}));
+    }
+  }
+}
+
+}  // namespace
+
+Vec3 ConvexPiece::support(const Vec3& d) const {
+  switch (kind) {
+    case Kind::Sphere: {
+      const double n = d.norm();
+      return n > 0 ? Vec3(a + (radius / n) * d) : a;
+    }
+    case Kind::Cylinder: {
+      const Vec3 axis = b - a;
+      const double len2 = axis.squaredNorm();
+      const double along = d.dot(axis);
+      const Vec3 end = along >= 0 ? b : a;
+      const Vec3 across = len2 > 0 ? Vec3(d - (along / len2) * axis) : d;
+      const double n = across.norm();
+      return n > 0 ? Vec3(end + (radius / n) * across) : end;
+    }
+    case Kind::Polytope: {
+      const Vec3* best = &vertices[0];
+      double best_dot = best->dot(d);
+      for (const Vec3& v : vertices) {
+        const double dot = v.dot(d);
+        if (dot > best_dot) {
+          best_dot = dot;
+          best = &v;
+        }
+      }
+      return *best;
+    }
+  }
+  return a;
+}
+
+double ConvexPiece::farthest_distance(const Vec3& p) const {
+  switch (kind) {
+    case Kind::Sphere:
+      return (a - p).norm() + radius;
+    case Kind::Cylinder: {
+      const Vec3 axis = b - a;
+      const double len = axis.norm();
+      if (len == 0) return (a - p).norm() + radius;
+      const Vec3 n = axis / len;
+      return std::max(farthest_on_disk(p, a, n, radius), farthest_on_disk(p, b, n, radius));
+    }
+    case Kind::Polytope: {
+      double best = 0;
+      for (const Vec3& v : vertices) best = std::max(best, (v - p).norm());
+      return best;
+    }
+  }
+  return 0;
+}
+
+double ComponentGeometry::farthest_distance(const Vec3& point) const {
+  double best = 0;
+  for (const ConvexPiece& piece : pieces) best = std::max(best, piece.farthest_distance(point));
+  return best;
+}
+
+ComponentGeometry build_component_geometry(const std::vector<BodyShape>& shapes) {
+  ComponentGeometry g;
+  for (int k = 0; k < static_cast<int>(shapes.size()); ++k) {
+    std::visit(Overloaded{
+                   [&](const Sphere& s) {
+                     ConvexPiece p;
+                     p.kind = ConvexPiece::Kind::Sphere;
+                     p.shape = k;
+                     p.a = s.center;
+                     p.radius = s.radius;
+                     g.pieces.push_back(p);
+                   },
+                   [&](const Wire& w) {
+                     ConvexPiece p;
+                     p.kind = ConvexPiece::Kind::Cylinder;
+                     p.shape = k;
+                     p.a = w.from;
+                     p.b = w.to;
+                     p.radius = w.radius;
+                     g.pieces.push_back(p);
+                   },
+                   [&](const Box& b) {
+                     std::vector<Vec3> corners;
+                     for (int c = 0; c < 8; ++c) {
+                       const Vec3 sign((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1);
+                       corners.push_back(b.center + b.rotation * (0.5 * b.size.cwiseProduct(sign)));
+                     }
+                     g.pieces.push_back(polytope(k, std::move(corners)));
+                   },
+                   [&](const Plate& p) { add_plate(k, p, g.pieces); },
+                   [&](const Mesh& m) { add_mesh(k, m.mesh, g.pieces); },
+               },
+               shapes[k].shape);
+  }
+  Bounds box;
+  for (ConvexPiece& piece : g.pieces) {
+    const Bounds b = set_bounds(piece);
+    box.add(b.min);
+    box.add(b.max);
+  }
+  if (!g.pieces.empty()) {
+    g.box_center = 0.5 * (box.min + box.max);
+    g.box_half = 0.5 * (box.max - box.min);
+    g.bound_center = g.box_center;
+    g.bound_radius = g.farthest_distance(g.bound_center);
+    g.reach = g.farthest_distance(Vec3::Zero());
+  }
+  return g;
+}
+
+}  // namespace aloft::internal

@@ -1,0 +1,104 @@
+// General convex contact through libccd (GJK to find the overlap, EPA for depth, direction and point),
+// and the dispatch between it and the closed forms.
+//
+// Speculative distance: each piece is inflated by margin / 2 (its support moves margin / 2 along the
+// query direction: a Minkowski sum with a ball). For convex pieces the inflated signed distance is the
+// true one minus margin, and the separating direction is the same, so EPA's depth on the inflated pair
+// gives distance = margin - depth. The midpoint of the two inflated deepest points is the midpoint of
+// the two true closest points, since both moved by margin / 2 towards each other.
+
+#include <ccd/ccd.h>
+
+#include <cmath>
+
+#include "collision/narrow_phase.hpp"
+
+namespace aloft::internal {
+
+namespace {
+
+struct Inflated {
+  const ConvexPiece* piece;
+  const Pose* pose;
+  double inflate;  // m
+};
+
+void support(const void* object, const ccd_vec3_t* direction, ccd_vec3_t* out) {
+  const auto& o = *static_cast<const Inflated*>(object);
+  const Vec3 d(direction->v[0], direction->v[1], direction->v[2]);
+  const Vec3 body = o.piece->support(o.pose->rotation.transpose() * d);
+  const double n = d.norm();
+  const Vec3 w = o.pose->to_world(body) + (n > 0 ? Vec3((o.inflate / n) * d) : Vec3::Zero());
+  ccdVec3Set(out, w.x(), w.y(), w.z());
+}
+
+void center(const void* object, ccd_vec3_t* out) {
+  const auto& o = *static_cast<const Inflated*>(object);
+  const Vec3 w = o.pose->to_world(o.piece->bound_center);
+  ccdVec3Set(out, w.x(), w.y(), w.z());
+}
+
+ccd_t make_ccd() {
+  ccd_t ccd;
+  CCD_INIT(&ccd);
+  ccd.support1 = support;
+  ccd.support2 = support;
+  ccd.center1 = center;
+  ccd.center2 = center;
+  // Pieces are millimetres to metres: EPA stops when its polytope is within 1e-8 m of the true
+  // boundary (libccd's default 1e-4 is coarser than a wire's radius); GJK stops at 1e-10 m.
+  ccd.max_iterations = 200;
+  ccd.epa_tolerance = 1e-8;
+  ccd.dist_tolerance = 1e-10;
+  ccd.mpr_tolerance = 1e-8;
+  return ccd;
+}
+
+}  // namespace
+
+bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
+                 double margin, PieceContact& out) {
+  static const ccd_t ccd = make_ccd();
+  const Inflated ia{&a, &pose_a, 0.5 * margin}, ib{&b, &pose_b, 0.5 * margin};
+  ccd_real_t depth = 0;
+  ccd_vec3_t dir, pos;
+  // libccd: "if obj2 is translated by depth in direction dir the objects touch": dir points from a
+  // towards b, so the normal from b towards a is -dir.
+  if (ccdGJKPenetration(&ia, &ib, &ccd, &depth, &dir, &pos) != 0) return false;
+  Vec3 n(-dir.v[0], -dir.v[1], -dir.v[2]);
+  const double len = n.norm();
+  if (!(len > 0) || !std::isfinite(depth)) return false;  // EPA degenerate: touching at exactly margin
+  out.normal = n / len;
+  out.distance = margin - depth;
+  out.point = Vec3(pos.v[0], pos.v[1], pos.v[2]);
+  return out.distance < margin;
+}
+
+bool piece_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
+                   double margin, PieceContact& out) {
+  using Kind = ConvexPiece::Kind;
+  auto flip = [](PieceContact& c) { c.normal = -c.normal; };
+  if (a.kind == Kind::Sphere && b.kind == Kind::Sphere) {
+    out = sphere_sphere(pose_a.to_world(a.a), a.radius, pose_b.to_world(b.a), b.radius);
+    return out.distance < margin;
+  }
+  if (a.kind == Kind::Cylinder && b.kind == Kind::Sphere) {
+    out = cylinder_sphere(pose_a.to_world(a.a), pose_a.to_world(a.b), a.radius, pose_b.to_world(b.a),
+                          b.radius);
+    return out.distance < margin;
+  }
+  if (a.kind == Kind::Sphere && b.kind == Kind::Cylinder) {
+    out = cylinder_sphere(pose_b.to_world(b.a), pose_b.to_world(b.b), b.radius, pose_a.to_world(a.a),
+                          a.radius);
+    flip(out);
+    return out.distance < margin;
+  }
+  if (a.kind == Kind::Cylinder && b.kind == Kind::Cylinder &&
+      cylinder_cylinder_sides(pose_a.to_world(a.a), pose_a.to_world(a.b), a.radius, pose_b.to_world(b.a),
+                              pose_b.to_world(b.b), b.radius, out)) {
+    return out.distance < margin;
+  }
+  return gjk_contact(a, pose_a, b, pose_b, margin, out);
+}
+
+}  // namespace aloft::internal
