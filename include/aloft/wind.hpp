@@ -27,6 +27,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "aloft/model.hpp"
@@ -34,6 +35,10 @@
 #include "aloft/state.hpp"
 
 namespace aloft {
+
+namespace internal {
+class ItemRasterizer;
+}
 
 // Density of air at 20 C, sea level (kg/m^3).
 inline constexpr double kAirDensity = 1.204;
@@ -103,12 +108,16 @@ class Wind {
  public:
   // Builds the body-frame triangle meshes of every component once. Throws std::invalid_argument on bad
   // source or settings.
+  // The Wind keeps a reference to `model`, which must outlive it.
   Wind(const Model& model, const WindSource& source, const WindSettings& settings = {});
+  ~Wind();
+  Wind(const Wind&) = delete;
+  Wind& operator=(const Wind&) = delete;
 
   // Move or re-aim the source, change the settings (resolution, alpha...). Elements stay until the next
   // refresh; the turbulence process keeps its state (a new seed restarts it).
   void set_source(const WindSource& source);
-  void set_settings(const WindSettings& settings);
+  void set_settings(const WindSettings& settings);   // round_segments cannot change
   const WindSource& source() const { return source_; }
   const WindSettings& settings() const { return settings_; }
   double alpha() const;  // the effective alpha (settings.alpha, or kAirDensity * l0^4)
@@ -137,23 +146,42 @@ class Wind {
   void reset_turbulence();
   void step_turbulence(double dt);
 
+  struct TileAccumulator {
+    int plane;              // global plane id
+    int component;
+    std::uint32_t id;       // one triangle id of the plane
+    double area;            // m^2
+    Vec3 moment;            // sum of area * point, camera frame, m^3
+  };
+  const Vec3& triangle_point_body(std::size_t t) const { return triangle_point_body_[t]; }
+
   const Model& model_;
   WindSource source_;
   WindSettings settings_;
   Mat3 frame_;
   std::vector<ComponentMesh> meshes_;
-  std::vector<Vec3> triangle_normal_body_;      // per global triangle id (0-based)
+  // Per global triangle (id - 1): body-frame unit normal and one vertex, component, global plane id.
+  std::vector<Vec3> triangle_normal_body_;
+  std::vector<Vec3> triangle_point_body_;
   std::vector<int> triangle_component_;
-  std::vector<int> triangle_plane_;             // global plane id
+  std::vector<int> triangle_plane_;
+  int plane_count_ = 0;
+  std::unique_ptr<internal::ItemRasterizer> rasterizer_;
   ItemBuffer buffer_;
-  std::vector<float> depth_;                    // 1 / camera depth per pixel
   std::vector<WindElement> elements_;
   WindLoads last_;
   // Turbulence: one Ornstein-Uhlenbeck vector per component, unit variance per axis.
   std::vector<Vec3> gust_;
   std::uint64_t rng_state_ = 0;
-  // Scratch reused between refreshes.
+  // Scratch reused between calls (no allocation in apply()).
   std::vector<Vec3> camera_vertices_;
+  std::vector<TileAccumulator> tile_scratch_;
+  std::vector<char> plane_seen_;         // per id: camera-frame plane computed this refresh
+  std::vector<Vec3> plane_n_;            // per id: unit normal, camera frame
+  std::vector<double> plane_d_;          // per id: plane offset n . p, camera frame, m
+  std::vector<Mat3> rotation_;           // per component, body -> world, this apply()
+  std::vector<Vec3> pressure_center_;    // per component: sum |F| * arm
+  std::vector<double> pressure_weight_;  // per component: sum |F|
 };
 
 }  // namespace aloft

@@ -1,0 +1,119 @@
+// The envelope follower: windowed RMS, attack/release smoothing, noise-floor calibration, gain -> v0.
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "aloft/audio.hpp"
+
+namespace aloft {
+
+namespace {
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+// Per-sample factor of a one-pole smoother with time constant `ms` at `rate` Hz (1: no smoothing).
+double smoothing_factor(double ms, int rate) {
+  const double samples = ms * 1e-3 * rate;
+  return samples > 0 ? 1 - std::exp(-1 / samples) : 1.0;
+}
+
+}  // namespace
+
+void EnvelopeSettings::validate() const {
+  require(std::isfinite(window_ms) && window_ms > 0 && window_ms <= 1000, "the RMS window must be in (0, 1000] ms");
+  require(std::isfinite(attack_ms) && attack_ms >= 0 && attack_ms <= 10000, "the attack time must be in [0, 10000] ms");
+  require(std::isfinite(release_ms) && release_ms >= 0 && release_ms <= 10000, "the release time must be in [0, 10000] ms");
+  require(std::isfinite(gain) && gain >= 0, "the microphone gain must be >= 0 (m/s per unit RMS)");
+  require(std::isfinite(calibration_s) && calibration_s >= 0 && calibration_s <= 60,
+          "the noise calibration must last 0 to 60 s");
+  require(std::isfinite(noise_floor) && noise_floor <= 1, "the noise floor must be an RMS <= 1 (or < 0: calibrate)");
+  require(std::isfinite(max_v0) && max_v0 > 0, "the largest v0 must be > 0 m/s");
+}
+
+EnvelopeFollower::EnvelopeFollower(int sample_rate, const EnvelopeSettings& settings)
+    : rate_(sample_rate), settings_(settings) {
+  require(sample_rate >= 1000 && sample_rate <= 768000, "the sample rate must be in [1000, 768000] Hz");
+  settings.validate();
+  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(settings.window_ms * 1e-3 * rate_)));
+  window_.assign(n, 0.0f);
+  attack_ = smoothing_factor(settings.attack_ms, rate_);
+  release_ = smoothing_factor(settings.release_ms, rate_);
+  if (settings.noise_floor >= 0)
+    floor_ = settings.noise_floor;
+  else
+    recalibrate();
+}
+
+void EnvelopeFollower::recalibrate() {
+  if (settings_.calibration_s <= 0) {
+    calibrating_ = false;
+    return;
+  }
+  calibrating_ = true;
+  calibration_end_ = count_ + static_cast<std::uint64_t>(std::llround(settings_.calibration_s * rate_));
+  calibration_levels_.clear();
+}
+
+void EnvelopeFollower::push(const float* mono, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) push(mono[i]);
+}
+
+void EnvelopeFollower::push(float sample) {
+  const std::size_t n = window_.size();
+  const float square = sample * sample;
+  sum_ += static_cast<double>(square) - window_[head_];
+  window_[head_] = square;
+  if (++head_ == n) {
+    head_ = 0;
+    // Once per window, re-add the window exactly so rounding in the running sum cannot build up.
+    double exact = 0;
+    for (float s : window_) exact += s;
+    sum_ = exact;
+    if (calibrating_) calibration_levels_.push_back(static_cast<float>(std::sqrt(exact / n)));
+  }
+  rms_ = std::sqrt(std::max(0.0, sum_) / static_cast<double>(n));
+  envelope_ += (rms_ - envelope_) * (rms_ > envelope_ ? attack_ : release_);
+  ++count_;
+  if (calibrating_ && count_ >= calibration_end_) {
+    // The 95th percentile of the window levels: the room's sound, not its loudest click.
+    if (calibration_levels_.empty()) {
+      floor_ = rms_;
+    } else {
+      const std::size_t k = (calibration_levels_.size() - 1) * 95 / 100;
+      std::nth_element(calibration_levels_.begin(), calibration_levels_.begin() + static_cast<std::ptrdiff_t>(k),
+                       calibration_levels_.end());
+      floor_ = calibration_levels_[k];
+    }
+    calibrating_ = false;
+  }
+}
+
+double EnvelopeFollower::v0() const {
+  if (calibrating_) return 0;
+  return std::min(settings_.max_v0, settings_.gain * std::max(0.0, envelope_ - floor_));
+}
+
+SpeedSeries speed_from_audio(const AudioClip& clip, const EnvelopeSettings& settings, double interval) {
+  require(std::isfinite(interval) && interval > 0, "the speed series interval must be > 0 s");
+  const std::vector<float> mono = clip.mono();
+  EnvelopeFollower follower(clip.sample_rate, settings);
+  SpeedSeries series;
+  series.t.push_back(0);
+  series.v0.push_back(0);
+  std::size_t done = 0;
+  for (long long k = 1;; ++k) {
+    const std::size_t end = static_cast<std::size_t>(std::llround(k * interval * clip.sample_rate));
+    if (end > mono.size()) break;
+    follower.push(mono.data() + done, end - done);
+    done = end;
+    series.t.push_back(static_cast<double>(end) / clip.sample_rate);
+    series.v0.push_back(follower.v0());
+  }
+  return series;
+}
+
+}  // namespace aloft

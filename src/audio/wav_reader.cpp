@@ -1,0 +1,160 @@
+// RIFF/WAVE reading: PCM integer 8/16/24/32-bit, IEEE float 32/64-bit, WAVE_FORMAT_EXTENSIBLE; 1-8
+// channels. Every malformed input becomes an InputError naming the file, the byte offset and the problem.
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "aloft/audio.hpp"
+#include "aloft/error.hpp"
+
+namespace aloft {
+
+namespace {
+
+constexpr std::uint16_t kFormatPcm = 1;
+constexpr std::uint16_t kFormatFloat = 3;
+constexpr std::uint16_t kFormatExtensible = 0xFFFE;
+
+struct Reader {
+  const std::vector<std::uint8_t>& bytes;
+  const std::string& name;
+
+  [[noreturn]] void fail(std::size_t offset, const std::string& problem) const {
+    throw InputError(name, SourcePlace{"byte " + std::to_string(offset), 0, 0}, problem);
+  }
+  std::uint16_t u16(std::size_t at) const { return static_cast<std::uint16_t>(bytes[at] | (bytes[at + 1] << 8)); }
+  std::uint32_t u32(std::size_t at) const {
+    return static_cast<std::uint32_t>(bytes[at]) | (static_cast<std::uint32_t>(bytes[at + 1]) << 8) |
+           (static_cast<std::uint32_t>(bytes[at + 2]) << 16) | (static_cast<std::uint32_t>(bytes[at + 3]) << 24);
+  }
+  bool tag(std::size_t at, const char* four) const { return std::memcmp(bytes.data() + at, four, 4) == 0; }
+};
+
+// One sample at `p` (little-endian) as a float in [-1, 1].
+float decode(const std::uint8_t* p, std::uint16_t format, int bits) {
+  if (format == kFormatFloat) {
+    if (bits == 32) {
+      std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+                        (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+      float f;
+      std::memcpy(&f, &u, 4);
+      return f;
+    }
+    std::uint64_t u = 0;
+    for (int i = 7; i >= 0; --i) u = (u << 8) | p[i];
+    double d;
+    std::memcpy(&d, &u, 8);
+    return static_cast<float>(d);
+  }
+  switch (bits) {
+    case 8: return (static_cast<int>(p[0]) - 128) / 128.0f;  // unsigned, offset 128
+    case 16: return static_cast<std::int16_t>(p[0] | (p[1] << 8)) / 32768.0f;
+    case 24: {
+      std::int32_t v = static_cast<std::int32_t>((static_cast<std::uint32_t>(p[0]) << 8) |
+                                                 (static_cast<std::uint32_t>(p[1]) << 16) |
+                                                 (static_cast<std::uint32_t>(p[2]) << 24)) >> 8;
+      return static_cast<float>(v / 8388608.0);
+    }
+    default: {
+      std::int32_t v = static_cast<std::int32_t>(static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+                                                 (static_cast<std::uint32_t>(p[2]) << 16) |
+                                                 (static_cast<std::uint32_t>(p[3]) << 24));
+      return static_cast<float>(v / 2147483648.0);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<float> AudioClip::mono() const {
+  const std::size_t n = frames();
+  std::vector<float> out(n);
+  for (std::size_t f = 0; f < n; ++f) {
+    double sum = 0;
+    for (int c = 0; c < channels; ++c) sum += samples[f * channels + c];
+    out[f] = static_cast<float>(sum / channels);
+  }
+  return out;
+}
+
+AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+  const Reader r{bytes, name};
+  if (bytes.size() < 12) r.fail(0, "not a WAV file: " + std::to_string(bytes.size()) + " bytes, too short for a RIFF header");
+  if (!r.tag(0, "RIFF")) r.fail(0, "not a WAV file: it does not start with \"RIFF\"");
+  if (!r.tag(8, "WAVE")) r.fail(8, "not a WAV file: a RIFF file of another type (no \"WAVE\")");
+
+  bool have_format = false;
+  std::uint16_t format = 0, channels = 0, bits = 0, block_align = 0;
+  std::uint32_t rate = 0;
+  std::size_t at = 12;
+  while (at + 8 <= bytes.size()) {
+    const std::uint32_t size = r.u32(at + 4);
+    const std::size_t body = at + 8;
+    const bool is_data = r.tag(at, "data");
+    if (static_cast<std::uint64_t>(body) + size > bytes.size()) {
+      // A truncated data chunk (a recording cut short) keeps its whole frames; any other truncation is fatal.
+      if (!is_data)
+        r.fail(at, "truncated file: the \"" + std::string(reinterpret_cast<const char*>(bytes.data() + at), 4) +
+                       "\" chunk claims " + std::to_string(size) + " bytes, " + std::to_string(bytes.size() - body) +
+                       " are left");
+    }
+    if (r.tag(at, "fmt ")) {
+      if (size < 16) r.fail(at, "the \"fmt \" chunk is " + std::to_string(size) + " bytes, at least 16 are needed");
+      format = r.u16(body);
+      channels = r.u16(body + 2);
+      rate = r.u32(body + 4);
+      block_align = r.u16(body + 12);
+      bits = r.u16(body + 14);
+      if (format == kFormatExtensible) {
+        if (size < 40) r.fail(at, "WAVE_FORMAT_EXTENSIBLE \"fmt \" chunk is " + std::to_string(size) + " bytes, 40 are needed");
+        format = r.u16(body + 24);  // the sub-format GUID starts with the format code
+      }
+      if (format != kFormatPcm && format != kFormatFloat)
+        r.fail(body, "unsupported encoding (format code " + std::to_string(format) +
+                         "): only PCM integer and IEEE float are read");
+      if (channels < 1 || channels > 8) r.fail(body + 2, std::to_string(channels) + " channels: 1 to 8 are read");
+      if (rate < 1000 || rate > 768000) r.fail(body + 4, "sample rate " + std::to_string(rate) + " Hz is not plausible");
+      const bool int_ok = format == kFormatPcm && (bits == 8 || bits == 16 || bits == 24 || bits == 32);
+      const bool float_ok = format == kFormatFloat && (bits == 32 || bits == 64);
+      if (!int_ok && !float_ok)
+        r.fail(body + 14, std::to_string(bits) + "-bit " + (format == kFormatPcm ? "integer" : "float") +
+                              " samples are not supported (integer 8/16/24/32, float 32/64)");
+      if (block_align != channels * (bits / 8))
+        r.fail(body + 12, "block align " + std::to_string(block_align) + " does not match " + std::to_string(channels) +
+                              " channels of " + std::to_string(bits) + " bits");
+      have_format = true;
+    } else if (is_data) {
+      if (!have_format) r.fail(at, "the \"data\" chunk comes before any \"fmt \" chunk");
+      const std::size_t available = std::min<std::size_t>(size, bytes.size() - body);
+      const std::size_t frames = available / block_align;
+      AudioClip clip;
+      clip.file = name;
+      clip.sample_rate = static_cast<int>(rate);
+      clip.channels = channels;
+      clip.samples.resize(frames * channels);
+      const int width = bits / 8;
+      for (std::size_t i = 0; i < clip.samples.size(); ++i)
+        clip.samples[i] = decode(bytes.data() + body + i * width, format, bits);
+      for (float s : clip.samples)
+        if (!std::isfinite(s)) r.fail(body, "the float samples include a NaN or an infinity");
+      return clip;
+    }
+    at = body + size + (size & 1);  // chunks are padded to even sizes
+  }
+  if (!have_format) r.fail(12, "no \"fmt \" chunk: not a usable WAV file");
+  r.fail(bytes.size(), "no \"data\" chunk: the file holds no samples");
+}
+
+AudioClip read_wav(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, {}, std::string("cannot open the audio file: ") + std::strerror(errno));
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path, {}, "cannot read the audio file");
+  return parse_wav(bytes, path);
+}
+
+}  // namespace aloft
