@@ -69,7 +69,14 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   const double len = n.norm();
   if (!(len > 0) || !std::isfinite(depth)) return false;  // EPA degenerate: touching at exactly margin
   out.normal = n / len;
-  out.distance = margin - depth;
+  // libccd's EPA stops 1e-5..1e-4 m short on curved supports (spheres, wire rims, the inflation
+  // itself). The gap along any unit n, min over a of a.n - max over b of b.n, is at most the signed
+  // distance (which is its maximum over n), and is within second order of the normal's error of it:
+  // so take the gap along EPA's normal from the true supports. Conservative: never larger than the
+  // true distance, so a contact within the margin is never missed.
+  const Vec3 on_a = pose_a.to_world(a.support(pose_a.rotation.transpose() * -out.normal));
+  const Vec3 on_b = pose_b.to_world(b.support(pose_b.rotation.transpose() * out.normal));
+  out.distance = std::min(margin - static_cast<double>(depth), (on_a - on_b).dot(out.normal));
   out.point = Vec3(pos.v[0], pos.v[1], pos.v[2]);
   return out.distance < margin;
 }
