@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "common.hpp"
+#include "wind_options.hpp"
 
 namespace aloft::cli {
 
@@ -130,7 +132,9 @@ Runner add_simulate(CLI::App& app) {
     int every = 10;
     std::string out;
     bool damping_off = false;
+    bool no_collisions = false;
     bool quiet = false;
+    WindOptions wind;
   };
   auto o = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -151,7 +155,9 @@ Runner add_simulate(CLI::App& app) {
       ->check(integer_in(1, 1000000000));
   sub->add_option("-o,--out", o->out, "Trajectory CSV file (default: none)")->type_name("FILE");
   sub->add_flag("--damping-off", o->damping_off, "Switch off the mobile's air damping");
+  sub->add_flag("--no-collisions", o->no_collisions, "Let components pass through each other (no contact handling)");
   sub->add_flag("-q,--quiet", o->quiet, "Print neither progress nor the summary");
+  add_wind_options(sub, o->wind);
   sub->footer(
       "Starts from the designed pose at rest and prints a summary: steps, simulated and wall time, speed,\n"
       "energy drift and the largest joint separation seen. With --out, also writes the trajectory as CSV:\n"
@@ -164,15 +170,28 @@ Runner add_simulate(CLI::App& app) {
       "  aloft simulate random.json --duration 2 --dt 0.0005 --every 20 --out trajectory.csv\n"
       "  aloft simulate random.json -t 60 --damping-off        # check energy conservation\n"
       "  aloft simulate mobiles/steel-fish.json -t 30 --balance none   # as built: it swings\n"
+      "  aloft simulate mobiles/steel-fish.json -t 10 --wind 2.5        # a steady breath from the front\n"
+      "  aloft simulate mobiles/steel-fish.json -t 10 --wind-audio blow.wav --wind-from 0.5,1.8,1.5\n"
+      "\n"
+      "Wind: one of --wind, --wind-speed or --wind-audio switches it on. The source disc S0 sits at\n"
+      "--wind-from (default 1.5 m in front, +z, of the mobile's centre) and blows towards --wind-to (default\n"
+      "the mobile's centre); the cone's vertex is l0 behind S0. Occlusion is recomputed --wind-refresh times\n"
+      "per simulated second; the wind's force and torque are applied at every step. See docs/wind.md.\n"
       "\n"
       "Exit code 3 if the simulation fails (its state stops being finite); the CSV then holds the\n"
       "frames computed until then.\n");
   return [o] {
-    const Model model = load_mobile_as(o->file, o->balance);
+    Model model = load_mobile_as(o->file, o->balance);
+    if (o->no_collisions) model.contact.enabled = false;
     Simulation sim(model);
     if (o->dt > 0) sim.set_timestep(o->dt);
     if (o->damping_off) sim.set_damping(DampingSpec{});
     const double h = sim.timestep();
+    std::optional<WindDriver> wind = make_wind(model, sim.state(), o->wind, h);
+    double occlusion_seconds = 0;    // wall time spent in refresh_occlusion
+    long long refreshes = 0;
+    std::size_t elements = 0;        // summed over refreshes
+    double largest_move = 0, largest_turn = 0;
     const long long steps = std::max(1LL, static_cast<long long>(std::ceil(o->duration / h - 1e-9)));
 
     std::unique_ptr<Trajectory> csv;
@@ -190,6 +209,17 @@ Runner add_simulate(CLI::App& app) {
     bool ok = true;
     long long done = 0;
     while (done < steps) {
+      if (wind) {
+        if (done % wind->refresh_every == 0) {
+          const auto t0 = Clock::now();
+          wind->wind->refresh_occlusion(sim.state());
+          occlusion_seconds += seconds_since(t0);
+          ++refreshes;
+          elements += wind->wind->elements().size();
+        }
+        sim.loads().clear();
+        wind->wind->apply(sim.state(), wind->v0(sim.state().time), h, sim.loads());
+      }
       if (!sim.step()) {
         ok = false;
         break;
@@ -200,6 +230,10 @@ Runner add_simulate(CLI::App& app) {
         if (csv) csv->frame(s);
         worst_separation = std::max(worst_separation, max_joint_separation(model, s));
         peak_kinetic = std::max(peak_kinetic, kinetic_energy(model, s));
+        for (int c = 1; c < model.count; ++c) {
+          largest_move = std::max(largest_move, (s.position[c] - rest.position[c]).norm());
+          largest_turn = std::max(largest_turn, s.orientation[c].angularDistance(rest.orientation[c]));
+        }
       }
       if ((done & 63) == 0) progress.update(done, sim.state().time);
     }
@@ -234,6 +268,14 @@ Runner add_simulate(CLI::App& app) {
                   wall > 0 ? s.time / wall : 0.0);
       std::printf("energy drift      %s\n", energy.c_str());
       std::printf("joint separation  %.3e m (largest seen)\n", worst_separation);
+      std::printf("motion            %.3g m largest displacement, %.3g deg largest turn (from rest, every %d steps)\n",
+                  largest_move, largest_turn * 180 / 3.141592653589793, o->every);
+      if (wind) {
+        std::printf("wind              %s\n", wind->description.c_str());
+        std::printf("occlusion         %lld refreshes, %.3f ms each (mean), %.0f elements each (mean), %.1f %% of the wall time\n",
+                    refreshes, refreshes ? 1e3 * occlusion_seconds / refreshes : 0.0,
+                    refreshes ? static_cast<double>(elements) / refreshes : 0.0, wall > 0 ? 100 * occlusion_seconds / wall : 0.0);
+      }
       if (csv)
         std::printf("trajectory        %s (%lld frames x %d components)\n", o->out.c_str(), done / o->every + 1,
                     model.count);

@@ -91,6 +91,28 @@ struct SpeedSeries {
 // file and line for a bad number, a negative speed or times not increasing.
 SpeedSeries read_speed_csv(const std::string& path);
 
+// Feeds an EnvelopeFollower and records v0 every `interval` seconds of *audio* time (the follower's value
+// after the sample that ends each interval, sample index round(k interval rate)): the same series whether
+// the samples come from a file in one piece or from a device in chunks of any size.
+class SpeedSampler {
+ public:
+  SpeedSampler(int sample_rate, const EnvelopeSettings& settings, double interval = 0.001);
+  void push(const float* mono, std::size_t count);
+  const SpeedSeries& series() const { return series_; }
+  void forget_series();   // drop all recorded samples but the last (a long live session)
+  const EnvelopeFollower& follower() const { return follower_; }
+  EnvelopeFollower& follower() { return follower_; }
+
+ private:
+  EnvelopeFollower follower_;
+  int rate_;
+  double interval_;
+  long long next_k_ = 1;
+  std::uint64_t pushed_ = 0;
+  std::uint64_t next_end_ = 0;
+  SpeedSeries series_;
+};
+
 // The v0 of a recording, sampled every `interval` seconds (the follower's value at the end of each
 // interval), channels averaged.
 SpeedSeries speed_from_audio(const AudioClip& clip, const EnvelopeSettings& settings, double interval = 0.001);

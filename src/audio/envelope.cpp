@@ -97,23 +97,43 @@ double EnvelopeFollower::v0() const {
   return std::min(settings_.max_v0, settings_.gain * std::max(0.0, envelope_ - floor_));
 }
 
-SpeedSeries speed_from_audio(const AudioClip& clip, const EnvelopeSettings& settings, double interval) {
+SpeedSampler::SpeedSampler(int sample_rate, const EnvelopeSettings& settings, double interval)
+    : follower_(sample_rate, settings), rate_(sample_rate), interval_(interval) {
   require(std::isfinite(interval) && interval > 0, "the speed series interval must be > 0 s");
-  const std::vector<float> mono = clip.mono();
-  EnvelopeFollower follower(clip.sample_rate, settings);
-  SpeedSeries series;
-  series.t.push_back(0);
-  series.v0.push_back(0);
-  std::size_t done = 0;
-  for (long long k = 1;; ++k) {
-    const std::size_t end = static_cast<std::size_t>(std::llround(k * interval * clip.sample_rate));
-    if (end > mono.size()) break;
-    follower.push(mono.data() + done, end - done);
-    done = end;
-    series.t.push_back(static_cast<double>(end) / clip.sample_rate);
-    series.v0.push_back(follower.v0());
+  series_.t.push_back(0);
+  series_.v0.push_back(0);
+  next_end_ = static_cast<std::uint64_t>(std::llround(interval_ * rate_));
+}
+
+void SpeedSampler::push(const float* mono, std::size_t count) {
+  std::size_t i = 0;
+  while (i < count) {
+    // Samples up to the end of the current interval, then one record.
+    const std::uint64_t room = next_end_ - pushed_;
+    const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(room, count - i));
+    follower_.push(mono + i, take);
+    i += take;
+    pushed_ += take;
+    if (pushed_ == next_end_) {
+      series_.t.push_back(static_cast<double>(pushed_) / rate_);
+      series_.v0.push_back(follower_.v0());
+      ++next_k_;
+      next_end_ = static_cast<std::uint64_t>(std::llround(next_k_ * interval_ * rate_));
+    }
   }
-  return series;
+}
+
+void SpeedSampler::forget_series() {
+  if (series_.t.size() <= 1) return;
+  series_.t.erase(series_.t.begin(), series_.t.end() - 1);
+  series_.v0.erase(series_.v0.begin(), series_.v0.end() - 1);
+}
+
+SpeedSeries speed_from_audio(const AudioClip& clip, const EnvelopeSettings& settings, double interval) {
+  const std::vector<float> mono = clip.mono();
+  SpeedSampler sampler(clip.sample_rate, settings, interval);
+  sampler.push(mono.data(), mono.size());
+  return sampler.series();
 }
 
 }  // namespace aloft

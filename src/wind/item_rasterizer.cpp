@@ -95,9 +95,21 @@ void ItemRasterizer::draw_clipped(const Vec3* v, std::uint32_t id) {
     ec[i] = sx[j] * sy[k] - sx[k] * sy[j];
   }
   for (int y = y0; y <= y1; ++y) {
-    const int x0 = std::max(x_lo, row_first_[y]);
-    const int x1 = std::min(x_hi, row_last_[y]);
     const double py = y + 0.5;
+    // The span of this row where every edge function is >= 0: each is linear in x, so each bounds x on
+    // one side. Widened by one pixel against rounding; the exact test below decides each pixel.
+    double from = x_lo, to = x_hi;
+    for (int i = 0; i < 3; ++i) {
+      const double k = eb[i] * py + ec[i];
+      if (ea[i] > 0)
+        from = std::max(from, -k / ea[i] - 0.5 - 1);
+      else if (ea[i] < 0)
+        to = std::min(to, -k / ea[i] - 0.5 + 1);
+      else if (k < 0)
+        to = from - 1;  // parallel to the row and outside
+    }
+    const int x0 = std::max({x_lo, row_first_[y], static_cast<int>(std::ceil(std::max(from, -1.0)))});
+    const int x1 = std::min({x_hi, row_last_[y], static_cast<int>(std::floor(std::min(to, double(width_))))});
     std::uint32_t* id_row = ids_.data() + static_cast<std::size_t>(y) * width_;
     float* depth_row = depth_.data() + static_cast<std::size_t>(y) * width_;
     for (int x = x0; x <= x1; ++x) {

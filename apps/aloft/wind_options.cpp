@@ -1,0 +1,221 @@
+// The wind flags of `aloft simulate`.
+
+#include "wind_options.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "aloft/geometry.hpp"
+
+namespace aloft::cli {
+
+namespace {
+
+// "x,y,z" as a point (m), or nothing.
+std::optional<Vec3> read_point(const std::string& text) {
+  Vec3 p;
+  std::stringstream in(text);
+  for (int i = 0; i < 3; ++i) {
+    std::string field;
+    if (!std::getline(in, field, ',')) return std::nullopt;
+    try {
+      std::size_t used = 0;
+      p[i] = std::stod(field, &used);
+      if (used != field.size() || !std::isfinite(p[i])) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+  }
+  std::string rest;
+  if (std::getline(in, rest)) return std::nullopt;
+  return p;
+}
+
+CLI::Validator point_validator() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        return read_point(input) ? std::string() : "must be a point x,y,z in metres, got \"" + input + "\"";
+      },
+      "");
+}
+
+CLI::Validator non_negative() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(input, &used);
+          if (used == input.size() && std::isfinite(v) && v >= 0) return {};
+        } catch (const std::exception&) {
+        }
+        return "must be a number >= 0, got \"" + input + "\"";
+      },
+      "");
+}
+
+// Centre and radius (m) of a sphere around the whole mobile at `state`.
+std::pair<Vec3, double> mobile_sphere(const Model& model, const State& state) {
+  Bounds world;
+  for (int c = 0; c < model.count; ++c) {
+    const Mat3 rotation = state.orientation[c].toRotationMatrix();
+    for (const BodyShape& shape : model.shapes[c]) {
+      const Bounds b = shape_bounds(shape.shape);
+      for (int corner = 0; corner < 8; ++corner)
+        world.add(state.position[c] + rotation * Vec3((corner & 1) ? b.max.x() : b.min.x(),
+                                                      (corner & 2) ? b.max.y() : b.min.y(),
+                                                      (corner & 4) ? b.max.z() : b.min.z()));
+    }
+  }
+  return {0.5 * (world.min + world.max), 0.5 * (world.max - world.min).norm()};
+}
+
+std::string point_text(const Vec3& p) { return format("(%.3g, %.3g, %.3g)", p.x(), p.y(), p.z()); }
+
+}  // namespace
+
+void add_wind_options(CLI::App* sub, WindOptions& o) {
+  const char* group = "Wind (the paper's cone; see docs/wind.md)";
+  auto* constant = sub->add_option("--wind", o.constant, "Blow a steady wind: speed v0 at the source disc S0 (m/s, >= 0)")
+                       ->type_name("V0")
+                       ->check(non_negative())
+                       ->group(group);
+  auto* speed = sub->add_option("--wind-speed", o.speed_csv,
+                                "Wind speed v0 over time from a CSV of \"t,v0\" rows (s, m/s; linear in between, "
+                                "held after the end)")
+                    ->type_name("FILE")
+                    ->group(group);
+  auto* audio = sub->add_option("--wind-audio", o.audio,
+                                "Wind speed from a WAV recording of someone blowing on a microphone (envelope "
+                                "minus the noise floor of its first second, times --wind-gain)")
+                    ->type_name("FILE")
+                    ->group(group);
+  constant->excludes(speed)->excludes(audio);
+  speed->excludes(audio);
+  sub->add_option("--wind-from", o.from,
+                  "Centre of the source disc S0 (x,y,z, m); default: 1.5 m in front (+z) of the mobile's centre")
+      ->type_name("X,Y,Z")
+      ->check(point_validator())
+      ->group(group);
+  sub->add_option("--wind-to", o.to, "Where the wind blows (x,y,z, m); default: the mobile's centre")
+      ->type_name("X,Y,Z")
+      ->check(point_validator())
+      ->group(group);
+  sub->add_option("--wind-r0", o.r0, "Radius of S0 (m, > 0); default: the cone just covers the mobile")
+      ->type_name("R0")
+      ->check(positive_number())
+      ->group(group);
+  sub->add_option("--wind-l0", o.l0, "Distance from the cone's vertex to S0 (m, > 0)")
+      ->type_name("L0")
+      ->capture_default_str()
+      ->check(positive_number())
+      ->group(group);
+  sub->add_option("--wind-alpha", o.alpha,
+                  "Drag constant alpha of F = alpha A v0^2 / l1^4 cos (kg m, > 0); default: air, 1.204 * l0^4")
+      ->type_name("A")
+      ->check(positive_number())
+      ->group(group);
+  sub->add_option("--wind-beta", o.beta, "Turbulence: |F_random| < beta |F_stoke| (0: none, up to 10)")
+      ->type_name("B")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0))
+      ->group(group);
+  sub->add_option("--wind-gust-time", o.gust_time, "Correlation time of the turbulence (s, >= 0)")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(non_negative())
+      ->group(group);
+  sub->add_option("--wind-seed", o.seed, "Seed of the turbulence (same seed, same run)")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(integer_in(0, 4000000000000000000LL))
+      ->group(group);
+  sub->add_option("--wind-resolution", o.resolution, "Item buffer size for occlusion (pixels per side, 8 to 8192)")
+      ->type_name("PX")
+      ->capture_default_str()
+      ->check(integer_in(8, 8192))
+      ->group(group);
+  sub->add_option("--wind-tile", o.tile, "Pixels per side merged into one area element (1: every pixel)")
+      ->type_name("PX")
+      ->capture_default_str()
+      ->check(integer_in(1, 8192))
+      ->group(group);
+  sub->add_option("--wind-refresh", o.refresh, "Occlusion refreshes per simulated second (Hz, > 0)")
+      ->type_name("HZ")
+      ->capture_default_str()
+      ->check(positive_number())
+      ->group(group);
+  sub->add_option("--wind-gain", o.gain, "With --wind-audio: m/s of v0 per unit of RMS above the noise floor")
+      ->type_name("G")
+      ->capture_default_str()
+      ->check(non_negative())
+      ->group(group);
+  sub->add_option("--wind-noise-floor", o.noise_floor,
+                  "With --wind-audio: the noise floor (RMS, 0 to 1) instead of calibrating it")
+      ->type_name("RMS")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(group);
+  sub->add_option("--wind-calibrate", o.calibrate,
+                  "With --wind-audio: seconds of room sound at the start that set the noise floor")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0))
+      ->group(group);
+}
+
+std::optional<WindDriver> make_wind(const Model& model, const State& state, const WindOptions& o, double timestep) {
+  if (!o.any()) return std::nullopt;
+  WindDriver d;
+  // Where the wind comes from: S0 at `from` blowing towards `to`, the cone just covering the mobile
+  // unless r0 is given.
+  const auto [center, radius] = mobile_sphere(model, state);
+  const Vec3 to = o.to.empty() ? center : *read_point(o.to);
+  const Vec3 from = o.from.empty() ? Vec3(center + Vec3(0, 0, 1.5)) : *read_point(o.from);
+  if ((to - from).norm() < 1e-9) throw Failure("--wind-from and --wind-to must be two different points");
+  double r0 = o.r0;
+  if (r0 <= 0) {
+    const double reach = (center - from).norm() + o.l0;
+    const double sine = std::min(0.95, radius / reach);
+    r0 = o.l0 * sine / std::sqrt(1 - sine * sine);
+  }
+  WindSettings settings;
+  settings.alpha = o.alpha;
+  settings.beta = o.beta;
+  settings.correlation_time = o.gust_time;
+  settings.seed = static_cast<std::uint64_t>(o.seed);
+  settings.resolution = o.resolution;
+  settings.tile_pixels = std::min(o.tile, o.resolution);
+  try {
+    d.wind = std::make_unique<Wind>(model, WindSource::aimed(from, to, r0, o.l0), settings);
+  } catch (const std::invalid_argument& e) {
+    throw Failure(e.what());
+  }
+  d.refresh_every = std::max(1, static_cast<int>(std::lround(1.0 / (o.refresh * timestep))));
+
+  std::string speed;
+  if (o.constant) {
+    d.constant = *o.constant;
+    speed = format("v0 = %g m/s, steady", *o.constant);
+  } else if (!o.speed_csv.empty()) {
+    d.series = read_speed_csv(o.speed_csv);
+    speed = format("v0 from %s (%zu samples over %.3g s)", o.speed_csv.c_str(), d.series.t.size(), d.series.duration());
+  } else {
+    const AudioClip clip = read_wav(o.audio);
+    EnvelopeSettings envelope;
+    envelope.gain = o.gain;
+    envelope.noise_floor = o.noise_floor;
+    envelope.calibration_s = o.calibrate;
+    d.series = speed_from_audio(clip, envelope, 0.001);
+    double peak = 0;
+    for (double v : d.series.v0) peak = std::max(peak, v);
+    speed = format("v0 from %s (%.3g s, %d Hz, %d ch; peak v0 %.3g m/s)", o.audio.c_str(), clip.duration(),
+                   clip.sample_rate, clip.channels, peak);
+  }
+  d.description = speed + format("; S0 at %s r0 = %.3g m, l0 = %.3g m, towards %s; alpha = %.3g kg m, beta = %g; "
+                                 "occlusion %d px every %d steps",
+                                 point_text(from).c_str(), r0, o.l0, point_text(to).c_str(), d.wind->alpha(), o.beta,
+                                 o.resolution, d.refresh_every);
+  return d;
+}
+
+}  // namespace aloft::cli
