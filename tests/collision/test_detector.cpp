@@ -1,0 +1,91 @@
+// CollisionDetector::find_contacts: speculative margin, normal from b to a, determinism.
+
+#include <gtest/gtest.h>
+
+#include "aloft/collision.hpp"
+#include "aloft/spec.hpp"
+
+namespace aloft {
+namespace {
+
+// Two balls (radius 0.05 m) on threads hung 0.3 m apart from one bar-shaped hook; at rest their
+// surfaces are 0.3 - 0.1 = 0.2 m apart.
+Model two_balls() {
+  const std::string text = R"({"name": "two", "aloft": 1, "balance": {"mode": "none"},
+    "components": [
+      {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.2, 1, 0], "to": [0.2, 1, 0], "radius": 0.005}}]},
+      {"name": "left", "parent": "hook", "joint": [-0.15, 1, 0], "shapes": [
+        {"wire": {"from": [-0.15, 1, 0], "to": [-0.15, 0.6, 0], "radius": 0.001}},
+        {"sphere": {"center": [-0.15, 0.55, 0], "radius": 0.05}}]},
+      {"name": "right", "parent": "hook", "joint": [0.15, 1, 0], "shapes": [
+        {"wire": {"from": [0.15, 1, 0], "to": [0.15, 0.6, 0], "radius": 0.001}},
+        {"sphere": {"center": [0.15, 0.55, 0], "radius": 0.05}}]}]})";
+  return compile(parse_mobile_text(text, "two.json"));
+}
+
+// Move `i` rigidly by `shift` (m).
+void shift(State& s, int i, const Vec3& d) { s.position[i] += d; }
+
+TEST(Detector, SpeculativeMarginAndNormal) {
+  const Model m = two_balls();
+  CollisionDetector detector(m);
+  ASSERT_EQ(detector.pairs().candidate_count, 1);  // left-right; both joined to the hook
+  const int left = 1, right = 2;
+  ASSERT_EQ(m.names[left], "left");
+  State s = rest_state(m);
+  std::vector<Contact> contacts;
+  // Left ball moved 0.19 m towards the right one: gap 0.01 m.
+  shift(s, left, Vec3(0.19, 0, 0));
+  detector.find_contacts(s, 0.001, 0.005, contacts);  // margin 5 mm < 10 mm gap, at rest
+  EXPECT_TRUE(contacts.empty());
+  detector.find_contacts(s, 0.001, 0.02, contacts);   // margin 20 mm > gap
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].a, left);
+  EXPECT_EQ(contacts[0].b, right);
+  EXPECT_NEAR(contacts[0].distance, 0.01, 1e-12);        // sphere-sphere closed form: round-off only
+  EXPECT_TRUE(contacts[0].normal.isApprox(-Vec3::UnitX()));  // from right (b) towards left (a)
+  EXPECT_TRUE(contacts[0].point.isApprox(Vec3(0.095, 0.55, 0)));  // midway between x = 0.09 and 0.10
+  // Speed widens the margin: 5 mm + 1 ms * (8 m/s + 0) = 13 mm > 10 mm gap.
+  s.velocity[left] = Vec3(8, 0, 0);
+  detector.find_contacts(s, 0.001, 0.005, contacts);
+  EXPECT_EQ(contacts.size(), 1u);
+  // Overlap: negative distance.
+  s.velocity[left].setZero();
+  shift(s, left, Vec3(0.02, 0, 0));
+  detector.find_contacts(s, 0.001, 0.005, contacts);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].distance, -0.01, 1e-12);
+}
+
+TEST(Detector, DeterministicOnTheSteelFishSwung) {
+  const Model m = load_mobile(std::string(ALOFT_SOURCE_DIR) + "/mobiles/steel-fish.json");
+  CollisionDetector one(m), two(m);
+  State s = rest_state(m);
+  // Swing O6's subtree by 1.2 rad about z at its joint so parts of it meet others.
+  std::vector<Contact> c1, c2, c3;
+  for (int i = 1; i < m.count; ++i) {
+    const Quat turn(Eigen::AngleAxisd(0.9 * i, Vec3(0.3, 1, 0.2).normalized()));
+    s.orientation[i] = turn * s.orientation[i];
+  }
+  one.find_contacts(s, 0.001, 0.2, c1);
+  one.find_contacts(s, 0.001, 0.2, c3);
+  two.find_contacts(s, 0.001, 0.2, c2);
+  ASSERT_FALSE(c1.empty());  // a 0.2 m margin in a jumbled pose finds contacts
+  ASSERT_EQ(c1.size(), c2.size());
+  ASSERT_EQ(c1.size(), c3.size());
+  for (std::size_t k = 0; k < c1.size(); ++k) {
+    EXPECT_LT(c1[k].a, c1[k].b);
+    if (k > 0) EXPECT_LE(std::pair(c1[k - 1].a, c1[k - 1].b), std::pair(c1[k].a, c1[k].b));
+    EXPECT_EQ(c1[k].a, c2[k].a);
+    EXPECT_EQ(c1[k].b, c2[k].b);
+    EXPECT_EQ(c1[k].distance, c2[k].distance);  // bit for bit
+    EXPECT_EQ(c1[k].distance, c3[k].distance);
+    EXPECT_EQ(c1[k].normal, c2[k].normal);
+    EXPECT_LT(c1[k].distance, 0.2);
+    EXPECT_NEAR(c1[k].normal.norm(), 1, 1e-12);
+    EXPECT_NE(m.parent[c1[k].b], c1[k].a);  // the joint between a parent and a child is not a contact
+  }
+}
+
+}  // namespace
+}  // namespace aloft
