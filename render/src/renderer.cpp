@@ -17,7 +17,7 @@ constexpr float kWallColor[3] = {0.84f, 0.82f, 0.78f};    // warm white
 constexpr float kBackground[3] = {0.16f, 0.16f, 0.17f};   // beyond the room (seen from behind the wall)
 constexpr float kMobileSpecular = 0.35f, kMobileShininess = 48.0f;  // painted steel
 constexpr float kRoomSpecular = 0.03f, kRoomShininess = 8.0f;       // matt paint
-// Soft-shadow filter radius as a fraction of the shadow map's width (with 2048 texels: 5 texels).
+// Soft-shadow filter radius as a fraction of the shadow map's width (with 1024 texels: 2.5 texels).
 constexpr float kShadowRadius = 0.0025f;
 
 void set_mat4(GLint location, const Mat4f& m) { glUniformMatrix4fv(location, 1, GL_FALSE, m.data()); }
@@ -215,6 +215,7 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, int width, in
   // 1. Shadow map: depth of the mobile as the key light sees it.
   const Mat4f light_vp = m.light_view_proj();
   if (options.shadows) {
+    // (Without the mobile the map stays clear: nothing casts.)
     m.ensure_shadow_map(options.shadow_map_size);
     glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
     glViewport(0, 0, m.shadow_size, m.shadow_size);
@@ -224,7 +225,7 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, int width, in
     glPolygonOffset(2.0f, 4.0f);  // against self-shadowing acne on lit faces
     m.depth.use();
     set_mat4(m.depth.uniform("u_light_view_proj"), light_vp);
-    m.draw_mobile(m.depth, state, false, -1);
+    if (options.mobile) m.draw_mobile(m.depth, state, false, -1);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target_fbo));
   }
@@ -251,7 +252,7 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, int width, in
   glDisable(GL_CULL_FACE);
   glUniform2f(m.lit.uniform("u_material"), kMobileSpecular, kMobileShininess);
   glUniform1i(m.lit.uniform("u_room"), 0);
-  m.draw_mobile(m.lit, state, true, options.highlighted);
+  if (options.mobile) m.draw_mobile(m.lit, state, true, options.highlighted);
 
   if (options.room) {
     glEnable(GL_CULL_FACE);  // from behind the wall or below the floor, see through them

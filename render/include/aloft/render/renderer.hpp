@@ -18,8 +18,9 @@ namespace aloft::render {
 struct DrawOptions {
   bool shadows = true;
   bool room = true;               // floor and wall
+  bool mobile = true;             // false: the empty room (tests compare against it)
   int highlighted = -1;           // component drawn with a warm glow (the grabbed one), -1: none
-  int shadow_map_size = 2048;     // texels per side
+  int shadow_map_size = 1024;     // texels per side (the light's frustum is fitted to the mobile)
 };
 
 // Line segments drawn over the scene (depth-tested): the wind cone, the grab spring.

@@ -1,0 +1,303 @@
+// The viewer's Dear ImGui panel (playback, mobile settings, wind, view, capture), its key help, the
+// error banner, and the lines drawn over the scene (wind cone, occlusion elements, mouse spring).
+
+#include <imgui.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "viewer_state.hpp"
+
+namespace aloft::view {
+
+namespace {
+
+const char* balance_name(BalanceMode m) {
+  switch (m) {
+    case BalanceMode::Mass: return "mass (hangs still)";
+    case BalanceMode::Joints: return "joints (move hooks)";
+    case BalanceMode::None: return "none (as built)";
+  }
+  return "";
+}
+
+void help_window(bool& open) {
+  if (!open) return;
+  const ImVec2 centre = ImGui::GetMainViewport()->GetCenter();
+  ImGui::SetNextWindowPos(centre, ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::Begin("Keys and mouse", &open, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse);
+  static const char* const kRows[][2] = {
+      {"left drag", "orbit the camera"},
+      {"left drag on a piece", "grab it and pull (a spring to the cursor)"},
+      {"right / middle / shift+left drag", "pan"},
+      {"wheel", "zoom"},
+      {"ctrl + left drag", "aim the wind"},
+      {"drop a .json file", "load it"},
+      {"space", "play / pause"},
+      {"N or right arrow", "single step (pauses)"},
+      {"R", "reset to rest"},
+      {"+ / -", "time scale x2 / /2 (slow motion)"},
+      {"G", "a gust of wind"},
+      {"W", "wind on / off"},
+      {"K / O", "show the wind cone / what the wind reaches"},
+      {"S", "shadows on / off"},
+      {"C", "reset the camera"},
+      {"P or F12", "screenshot (PNG)"},
+      {"V", "start / stop recording (MP4)"},
+      {"H or tab", "hide / show the panel"},
+      {"?", "this help"},
+      {"Q or Esc", "quit"},
+  };
+  if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    for (const auto& row : kRows) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.45f, 1), "%s", row[0]);
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(row[1]);
+    }
+    ImGui::EndTable();
+  }
+  ImGui::TextDisabled("The mobile file is reloaded when it changes on disk.");
+  ImGui::End();
+}
+
+void error_banner(MobileSession& session) {
+  if (session.error().empty()) return;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + 10), ImGuiCond_Always,
+                          ImVec2(0.5f, 0));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(200, 0), ImVec2(vp->WorkSize.x * 0.6f, vp->WorkSize.y * 0.5f));
+  ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.55f, 0.08f, 0.06f, 0.94f));
+  ImGui::Begin("##error", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoFocusOnAppearing);
+  ImGui::PushTextWrapPos(vp->WorkSize.x * 0.58f);
+  ImGui::TextUnformatted(session.error().c_str());
+  ImGui::PopTextWrapPos();
+  ImGui::TextColored(ImVec4(1, 0.85f, 0.8f, 1), "The last good mobile keeps running. Fix the file and save it.");
+  if (ImGui::SmallButton("dismiss")) session.clear_error();
+  ImGui::End();
+  ImGui::PopStyleColor();
+}
+
+}  // namespace
+
+void style_panel() {
+  ImGui::StyleColorsDark();
+  ImGuiStyle& s = ImGui::GetStyle();
+  s.WindowRounding = 6;
+  s.FrameRounding = 4;
+  s.GrabRounding = 4;
+  s.WindowBorderSize = 0;
+  s.Colors[ImGuiCol_WindowBg] = ImVec4(0.10f, 0.10f, 0.11f, 0.86f);
+  s.Colors[ImGuiCol_Header] = ImVec4(0.30f, 0.22f, 0.16f, 0.8f);
+  s.Colors[ImGuiCol_HeaderHovered] = ImVec4(0.45f, 0.30f, 0.18f, 0.8f);
+  s.Colors[ImGuiCol_Button] = ImVec4(0.28f, 0.24f, 0.21f, 1);
+  s.Colors[ImGuiCol_ButtonHovered] = ImVec4(0.55f, 0.32f, 0.16f, 1);
+  s.Colors[ImGuiCol_FrameBg] = ImVec4(0.22f, 0.21f, 0.20f, 1);
+  s.Colors[ImGuiCol_SliderGrab] = ImVec4(0.85f, 0.45f, 0.20f, 1);
+  s.Colors[ImGuiCol_CheckMark] = ImVec4(0.95f, 0.55f, 0.25f, 1);
+  s.Colors[ImGuiCol_PlotHistogram] = ImVec4(0.85f, 0.45f, 0.20f, 1);
+}
+
+std::vector<render::LineSet> ViewerState::overlay_lines() const {
+  std::vector<render::LineSet> lines;
+  const State& state = session->simulation().state();
+  if (const auto& g = session->grabbed()) {
+    render::LineSet spring;
+    spring.color = {1.0f, 0.55f, 0.15f, 1.0f};
+    spring.points = {g->point_world(state), g->target};
+    lines.push_back(std::move(spring));
+  }
+#if ALOFT_HAVE_WIND
+  const Wind* wind = session->wind();
+  if (wind && session->wind_control.enabled && show_cone) {
+    const WindSource& src = wind->source();
+    const Mat3 frame = wind->frame();
+    const Vec3 right = frame.col(0), up = frame.col(1);
+    render::LineSet cone;
+    cone.color = {0.45f, 0.75f, 1.0f, 0.75f};
+    constexpr int kSides = 48;
+    const double reach = src.l0 + 2 * session->wind_control.distance;  // drawn length of the cone, m
+    for (double l : {src.l0, reach}) {
+      const double r = src.r0 * l / src.l0;
+      const Vec3 c = src.vertex + l * src.direction;
+      for (int k = 0; k < kSides; ++k) {
+        const double a0 = 2 * std::numbers::pi * k / kSides, a1 = 2 * std::numbers::pi * (k + 1) / kSides;
+        cone.points.push_back(c + r * (std::cos(a0) * right + std::sin(a0) * up));
+        cone.points.push_back(c + r * (std::cos(a1) * right + std::sin(a1) * up));
+      }
+    }
+    for (int k = 0; k < 8; ++k) {
+      const double a = 2 * std::numbers::pi * k / 8;
+      const Vec3 rim = std::cos(a) * right + std::sin(a) * up;
+      cone.points.push_back(src.vertex);
+      cone.points.push_back(src.vertex + reach * src.direction + src.r0 * reach / src.l0 * rim);
+    }
+    lines.push_back(std::move(cone));
+  }
+  if (wind && session->wind_control.enabled && show_occlusion) {
+    // Every area element the wind reaches: a short hair along its normal, facing the wind, and a cross.
+    render::LineSet hairs;
+    hairs.color = {0.2f, 1.0f, 0.85f, 1.0f};
+    const Vec3 d = wind->source().direction;
+    for (const WindElement& e : wind->elements()) {
+      const int c = e.component;
+      if (c < 0 || c >= static_cast<int>(state.position.size())) continue;
+      const Vec3 p = state.position[c] + state.orientation[c] * e.point_body;
+      Vec3 n = state.orientation[c] * e.normal_body;
+      if (n.dot(d) > 0) n = -n;
+      const double size = std::clamp(std::sqrt(e.area), 0.006, 0.05);  // m: about the element's width
+      hairs.points.insert(hairs.points.end(), {p, p + n * size * 1.5});
+      const Vec3 a = n.unitOrthogonal() * size * 0.5, b = n.cross(a);
+      hairs.points.insert(hairs.points.end(), {p - a, p + a, p - b, p + b});
+    }
+    lines.push_back(std::move(hairs));
+  }
+#endif
+  return lines;
+}
+
+void ViewerState::draw_panel() {
+  error_banner(*session);
+  help_window(show_help);
+  const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!message.empty() && now < message_until) {
+    const ImGuiViewport* vp = ImGui::GetMainViewport();
+    ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y - 12),
+                            ImGuiCond_Always, ImVec2(0.5f, 1));
+    ImGui::Begin("##message", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                           ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoInputs);
+    ImGui::TextUnformatted(message.c_str());
+    ImGui::End();
+  }
+  if (!show_panel) return;
+
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, 0), ImGuiCond_Always);
+  ImGui::Begin("Aloft", &show_panel, ImGuiWindowFlags_NoResize);
+  ImGui::PushItemWidth(150);
+  const Model& model = session->model();
+  Simulation& sim = session->simulation();
+
+  ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.5f, 1), "%s", model.name.c_str());
+  ImGui::TextDisabled("%s  (%d pieces, %.3g kg)", session->path().c_str(), model.count - 1, model.balance.total_mass);
+  ImGui::Separator();
+
+  // Playback and speed.
+  const double fps = 1 / std::max(stats.frame_seconds, 1e-6);
+  ImGui::Text("%.0f fps   real time x%.2f   t = %.2f s", fps, stats.realtime, sim.state().time);
+  ImGui::TextDisabled("physics %.2f ms  wind %.2f ms  render %.1f ms", stats.physics * 1e3,
+                      stats.wind * 1e3, stats.render * 1e3);
+  if (ImGui::Button(session->paused ? "Play" : "Pause", ImVec2(70, 0))) session->paused = !session->paused;
+  ImGui::SameLine();
+  if (ImGui::Button("Step")) {
+    session->paused = true;
+    session->single_step();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Reset")) session->reset();
+  ImGui::SameLine();
+  ImGui::TextDisabled("(?) keys");
+  if (ImGui::IsItemClicked()) show_help = true;
+  float scale = static_cast<float>(session->time_scale);
+  if (ImGui::SliderFloat("time scale", &scale, 1.0f / 64, 4.0f, "x%.3g", ImGuiSliderFlags_Logarithmic))
+    session->time_scale = scale;
+
+  if (ImGui::CollapsingHeader("Mobile")) {
+    BuildSettings build = session->build_settings();
+    const BalanceMode mode = build.balance.value_or(session->spec().balance.mode);
+    if (ImGui::BeginCombo("balance", balance_name(mode))) {
+      for (BalanceMode m : {BalanceMode::Mass, BalanceMode::Joints, BalanceMode::None})
+        if (ImGui::Selectable(balance_name(m), m == mode)) {
+          build.balance = m;
+          session->rebuild(build);
+        }
+      ImGui::EndCombo();
+    }
+    float mass = static_cast<float>(model.balance.total_mass);
+    ImGui::BeginDisabled(mode != BalanceMode::Mass);
+    ImGui::SliderFloat("total mass (kg)", &mass, 0.05f, 50.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
+    if (ImGui::IsItemDeactivatedAfterEdit()) {
+      build.total_mass = mass;
+      session->rebuild(build);
+    }
+    ImGui::EndDisabled();
+    float restitution = static_cast<float>(build.restitution.value_or(session->spec().contact.restitution));
+    ImGui::SliderFloat("restitution", &restitution, 0.0f, 1.0f, "%.2f");
+    if (ImGui::IsItemDeactivatedAfterEdit()) {
+      build.restitution = restitution;
+      session->rebuild(build);
+    }
+    float friction = static_cast<float>(build.friction.value_or(session->spec().contact.friction));
+    ImGui::SliderFloat("friction", &friction, 0.0f, 2.0f, "%.2f");
+    if (ImGui::IsItemDeactivatedAfterEdit()) {
+      build.friction = friction;
+      session->rebuild(build);
+    }
+    bool contact = build.contact_enabled.value_or(session->spec().contact.enabled);
+    if (ImGui::Checkbox("collisions", &contact)) {
+      build.contact_enabled = contact;
+      session->rebuild(build);
+    }
+    DampingSpec damping = session->damping();
+    float linear = static_cast<float>(damping.linear), angular = static_cast<float>(damping.angular);
+    bool changed = ImGui::SliderFloat("air damping (1/s)", &linear, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    changed |= ImGui::SliderFloat("spin damping (1/s)", &angular, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    if (changed) session->set_damping(DampingSpec{linear, angular});
+  }
+
+#if ALOFT_HAVE_WIND
+  if (ImGui::CollapsingHeader("Wind", ImGuiTreeNodeFlags_DefaultOpen)) {
+    WindControl& w = session->wind_control;
+    ImGui::Checkbox("wind", &w.enabled);
+    ImGui::SameLine();
+    if (ImGui::Button("Gust (G)")) session->gust();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(w.follow_camera);
+    if (ImGui::Button("From me")) w.follow_camera = true;
+    ImGui::EndDisabled();
+    float breeze = static_cast<float>(w.breeze);
+    if (ImGui::SliderFloat("breeze v0 (m/s)", &breeze, 0.0f, 10.0f, "%.2f")) w.breeze = breeze;
+    const double v0 = session->v0();
+    ImGui::ProgressBar(static_cast<float>(std::min(v0 / 10, 1.0)), ImVec2(-1, 0),
+                       (std::to_string(static_cast<int>(std::lround(v0 * 100)) / 100.0).substr(0, 4) + " m/s at S0").c_str());
+    float r0 = static_cast<float>(w.r0), l0 = static_cast<float>(w.l0);
+    if (ImGui::SliderFloat("r0 (m)", &r0, 0.05f, 3.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.r0 = r0;
+    if (ImGui::SliderFloat("l0 (m)", &l0, 0.1f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.l0 = l0;
+    float alpha = static_cast<float>(session->wind() ? session->wind()->alpha() : kAirDensity * std::pow(w.l0, 4));
+    if (ImGui::SliderFloat("alpha (kg m)", &alpha, 0.01f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic))
+      w.settings.alpha = alpha;
+    ImGui::SameLine();
+    if (ImGui::SmallButton("air")) w.settings.alpha = -1;
+    float beta = static_cast<float>(w.settings.beta);
+    if (ImGui::SliderFloat("beta (turbulence)", &beta, 0.0f, 2.0f, "%.2f")) w.settings.beta = beta;
+    ImGui::Checkbox("cone (K)", &show_cone);
+    ImGui::SameLine();
+    ImGui::Checkbox("what it reaches (O)", &show_occlusion);
+    ImGui::TextDisabled("ctrl + drag to aim it");
+    draw_microphone_controls();
+  }
+#endif
+
+  if (ImGui::CollapsingHeader("View")) {
+    ImGui::Checkbox("shadows (S)", &shadows);
+    static const int kSamples[] = {0, 2, 4, 8};
+    static const char* const kSampleNames[] = {"off", "2x", "4x", "8x"};
+    int index = 0;
+    for (int i = 0; i < 4; ++i)
+      if (kSamples[i] == samples) index = i;
+    if (ImGui::Combo("anti-aliasing", &index, kSampleNames, 4)) samples = kSamples[index];
+    if (ImGui::Button("Reset camera (C)")) camera = framed_camera();
+    ImGui::SameLine();
+    if (ImGui::Button("Screenshot (P)")) screenshot_requested = true;
+    ImGui::SameLine();
+    if (ImGui::Button(recorder ? "Stop (V)" : "Record (V)")) toggle_recording();
+    if (recorder) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "recording %s", recorder->path().c_str());
+  }
+  ImGui::PopItemWidth();
+  ImGui::End();
+}
+
+}  // namespace aloft::view
