@@ -46,7 +46,7 @@ SpeedSeries read_speed_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path, {}, std::string("cannot open the speed series: ") + std::strerror(errno));
   SpeedSeries series;
-  std::string line;
+  std::string line, previous_t;
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
@@ -64,9 +64,10 @@ SpeedSeries read_speed_csv(const std::string& path) {
     }
     if (v < 0) fail("the speed v0 must be >= 0 m/s, got " + trim(text.substr(comma + 1)));
     if (!series.t.empty() && t <= series.t.back())
-      fail("times must increase: " + trim(text.substr(0, comma)) + " s after " + std::to_string(series.t.back()) + " s");
+      fail("times must increase: " + trim(text.substr(0, comma)) + " s after " + previous_t + " s");
     series.t.push_back(t);
     series.v0.push_back(v);
+    previous_t = trim(text.substr(0, comma));
   }
   if (in.bad()) throw InputError(path, {}, "cannot read the speed series");
   if (series.t.empty()) throw InputError(path, {}, "no \"t,v0\" rows");

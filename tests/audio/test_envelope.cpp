@@ -1,0 +1,111 @@
+// The envelope follower and v0: silence gives 0, a burst gives a clear v0 within 50 ms, the noise floor is
+// calibrated from the first second, and a speed CSV reads back with clear errors.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include "aloft/audio.hpp"
+#include "aloft/error.hpp"
+
+namespace aloft::test {
+namespace {
+
+// 1 s of `floor_rms` noise (a quiet room) then 1 s of white noise of RMS 0.2 (a breath), at 48 kHz.
+AudioClip silence_then_noise(double floor_rms) {
+  AudioClip clip;
+  clip.file = "synthetic";
+  clip.sample_rate = 48000;
+  clip.channels = 1;
+  std::mt19937 rng(2);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  for (int i = 0; i < 96000; ++i) clip.samples.push_back((i < 48000 ? static_cast<float>(floor_rms) : 0.2f) * normal(rng));
+  return clip;
+}
+
+TEST(Envelope, QuietThenBurstRisesWithinFiftyMilliseconds) {
+  const SpeedSeries s = speed_from_audio(silence_then_noise(0.002), EnvelopeSettings{}, 0.001);
+  // Quiet second: v0 is 0 while calibrating and ~0 after (the floor is the 95th percentile of the room).
+  double quiet = 0;
+  for (std::size_t i = 0; i < s.t.size(); ++i)
+    if (s.t[i] < 0.999) quiet = std::max(quiet, s.v0[i]);
+  EXPECT_EQ(quiet, 0.0);  // the first second is the calibration: exactly 0
+  // Plateau: the mean over 1.2-2 s; RMS 0.2 minus a floor of ~0.002, times the gain 25: ~5 m/s.
+  double plateau = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < s.t.size(); ++i)
+    if (s.t[i] > 1.2) plateau += s.v0[i], ++n;
+  plateau /= n;
+  EXPECT_NEAR(plateau, 25 * (0.2 - 0.002), 0.25);  // 5 %: the 5 ms window's RMS of white noise varies ~3 %
+  // Rise time, 10 % to 90 % of the plateau after the onset at 1 s.
+  double t10 = -1, t90 = -1;
+  for (std::size_t i = 0; i < s.t.size(); ++i) {
+    if (t10 < 0 && s.v0[i] >= 0.1 * plateau) t10 = s.t[i];
+    if (t90 < 0 && s.v0[i] >= 0.9 * plateau) t90 = s.t[i];
+  }
+  ASSERT_GT(t10, 0.999);
+  EXPECT_LT(t90 - t10, 0.050);
+  // Release is slower than attack: 50 ms after the end of a burst some wind remains.
+  EnvelopeFollower f(48000);
+  std::vector<float> zeros(48000, 0.0f), burst(4800);
+  f.push(zeros.data(), zeros.size());  // calibrate on silence: floor 0
+  std::mt19937 rng(3);
+  std::normal_distribution<float> normal(0.0f, 0.2f);
+  for (auto& x : burst) x = normal(rng);
+  f.push(burst.data(), burst.size());
+  const double during = f.v0();
+  f.push(zeros.data(), 2400);
+  // After 50 ms of silence with a 150 ms release: exp(-(50 - 5) / 150) = 0.74 of it remains; > 0.5 is a
+  // clear margin on both sides (a fast release would leave ~0).
+  EXPECT_GT(f.v0(), 0.5 * during);
+}
+
+TEST(Envelope, GivenNoiseFloorSkipsCalibration) {
+  EnvelopeSettings settings;
+  settings.noise_floor = 0.05;
+  settings.gain = 10;
+  EnvelopeFollower f(48000, settings);
+  EXPECT_FALSE(f.calibrating());
+  // A 0.1-amplitude square wave: RMS 0.1 exactly; v0 = 10 * (0.1 - 0.05) = 0.5 m/s once settled.
+  for (int i = 0; i < 48000; ++i) f.push(i % 2 ? 0.1f : -0.1f);
+  EXPECT_NEAR(f.v0(), 0.5, 1e-6);  // float squares summed exactly per window: rounding only
+}
+
+TEST(SpeedSeries, InterpolatesAndHoldsEnds) {
+  SpeedSeries s{{0, 1, 3}, {0, 2, 2}};
+  EXPECT_EQ(s.at(-1), 0);
+  EXPECT_EQ(s.at(0.5), 1);
+  EXPECT_EQ(s.at(2), 2);
+  EXPECT_EQ(s.at(10), 2);
+}
+
+TEST(SpeedSeries, CsvReaderReportsFileAndLine) {
+  const std::string path = ::testing::TempDir() + "aloft_speeds.csv";
+  auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+  };
+  write("t,v0\n# a comment\n0,0\n0.5,2.5\n1,1\n");
+  const SpeedSeries s = read_speed_csv(path);
+  ASSERT_EQ(s.t.size(), 3u);
+  EXPECT_EQ(s.at(0.75), 1.75);
+  auto message = [&](const std::string& text) {
+    write(text);
+    try {
+      read_speed_csv(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message("0,1\n0.5,x\n"), path + ":2: expected two numbers \"t,v0\", got \"0.5,x\"");
+  EXPECT_EQ(message("0,1\n0,2\n"), path + ":2: times must increase: 0 s after 0 s");
+  EXPECT_EQ(message("0,-1\n"), path + ":1: the speed v0 must be >= 0 m/s, got -1");
+  EXPECT_EQ(message("t,v0\n"), path + ": no \"t,v0\" rows");
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace aloft::test
