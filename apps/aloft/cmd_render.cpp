@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "aloft/render/frame_target.hpp"
 #include "aloft/render/headless_context.hpp"
@@ -14,6 +15,7 @@
 #include "aloft/simulation.hpp"
 #include "common.hpp"
 #include "view/camera_flags.hpp"
+#include "wind_options.hpp"
 
 namespace aloft::cli {
 
@@ -70,6 +72,7 @@ Runner add_render(CLI::App& app) {
     bool no_shadows = false;
     bool quiet = false;
     CameraFlags camera;
+    WindOptions wind;
   };
   auto o = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("render", "Render a mobile as it moves to a video or images, with no window");
@@ -94,6 +97,7 @@ Runner add_render(CLI::App& app) {
   sub->add_flag("--no-shadows", o->no_shadows, "Draw without shadows");
   sub->add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
   o->camera.add_to(sub);
+  add_wind_options(sub, o->wind);
   sub->footer(
       "Simulates the mobile from its designed pose at rest (as 'aloft simulate') and draws a frame every\n"
       "1/fps simulated seconds: frames at t = 0, 1/fps, ... (duration x fps of them). Rendering is offscreen\n"
@@ -103,10 +107,29 @@ Runner add_render(CLI::App& app) {
       "  aloft render mobiles/steel-fish.json --balance none --duration 10 --out fish.mp4\n"
       "  aloft render mobiles/southern-cross.json --duration 0.001 --out cross.png --width 1920 --height 1080\n"
       "  aloft render mobiles/steel-fish.json -t 4 --fps 15 --width 480 --height 270 --out fish.gif\n"
-      "  aloft render mobiles/steel-fish.json -t 2 --out frames/ --yaw 30 --pitch 20 --distance 5\n");
+      "  aloft render mobiles/steel-fish.json -t 2 --out frames/ --yaw 30 --pitch 20 --distance 5\n"
+      "  aloft render mobiles/steel-fish.json -t 8 --wind 2 --out breeze.mp4   # a steady breath from the front\n"
+      "\n"
+      "Wind: as in 'aloft simulate' (--wind, --wind-speed, --wind-audio and the source flags).\n");
   return [o] {
     const Model model = load_mobile_as(o->file, o->balance);
     Simulation sim(model);
+    std::optional<WindDriver> wind = make_wind(model, sim.state(), o->wind, sim.timestep());
+    long long steps = 0;
+    // Physics up to simulated time t: the wind's occlusion refreshed every refresh_every steps, its forces
+    // applied at every step (as 'aloft simulate' does).
+    const auto advance_to = [&](double t) {
+      while (sim.state().time < t - 0.5 * sim.timestep()) {
+        if (wind) {
+          if (steps % wind->refresh_every == 0) wind->wind->refresh_occlusion(sim.state());
+          sim.loads().clear();
+          wind->wind->apply(sim.state(), wind->v0(sim.state().time), sim.timestep(), sim.loads());
+        }
+        if (!sim.step()) return false;
+        ++steps;
+      }
+      return true;
+    };
 
     render::HeadlessContext context;
     render::Renderer renderer;
@@ -133,7 +156,7 @@ Runner add_render(CLI::App& app) {
     };
     if (!sink.wants_every_frame()) {
       // One still: the mobile at t = duration.
-      if (!sim.advance(o->duration)) {
+      if (!advance_to(o->duration)) {
         print_error(sim.failure() ? sim.failure()->message : "the simulation failed");
         return kExitSimulation;
       }
@@ -142,7 +165,7 @@ Runner add_render(CLI::App& app) {
       for (long long k = 0; k < frames; ++k) {
         // Frame k shows t = k / fps: step the physics up to that time first.
         const double t = static_cast<double>(k) * frame_time;
-        if (t > sim.state().time && !sim.advance(t - sim.state().time)) {
+        if (!advance_to(t)) {
           progress.finish();
           sink.finish();
           print_error(sim.failure() ? sim.failure()->message : "the simulation failed");
@@ -157,6 +180,7 @@ Runner add_render(CLI::App& app) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o->quiet) {
       std::printf("mobile     %s\n", model.name.c_str());
+      if (wind) std::printf("wind       %s\n", wind->description.c_str());
       std::printf("written    %s (%s, %.3g s simulated)\n", o->out.c_str(), written.c_str(), sim.state().time);
       std::printf("wall time  %.2f s (%.1f frames/s) on %s\n", wall, static_cast<double>(frames) / wall,
                   context.description().c_str());

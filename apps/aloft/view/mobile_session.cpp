@@ -43,7 +43,11 @@ double moving_mass(const Model& m) { return std::accumulate(m.mass.begin() + 1, 
 std::unique_ptr<Model> compile_with(const MobileSpec& spec_in, const BuildSettings& build) {
   MobileSpec spec = spec_in;
   if (build.balance) spec.balance.mode = *build.balance;
-  if (build.total_mass) spec.balance.total_mass = *build.total_mass;
+  if (build.total_mass) {
+    if (!(*build.total_mass > 0) || !std::isfinite(*build.total_mass))
+      throw std::invalid_argument("the total mass must be a positive number of kg");
+    spec.balance.total_mass = *build.total_mass;
+  }
   if (build.restitution) spec.contact.restitution = *build.restitution;
   if (build.friction) spec.contact.friction = *build.friction;
   if (build.contact_enabled) spec.contact.enabled = *build.contact_enabled;
@@ -249,7 +253,7 @@ double MobileSession::advance(double wall_seconds, double budget_seconds) {
   const double h = sim_->timestep();
   const double start_time = sim_->state().time;
   const auto start = Clock::now();
-  while (debt_ >= h && !failed()) {
+  while (debt_ >= h * (1 - 1e-9) && !failed()) {  // (a whole step owed, to rounding of the sums)
     step_once();
     debt_ -= h;
     if (seconds(Clock::now() - start) > budget_seconds) {

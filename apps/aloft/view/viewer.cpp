@@ -188,7 +188,7 @@ render::OrbitCamera ViewerState::framed_camera() const {
   int w = 1, h = 1;
   glfwGetFramebufferSize(window, &w, &h);
   render::OrbitCamera c = render::framing_camera(renderer->scene(), static_cast<double>(std::max(w, 1)) / std::max(h, 1));
-  if (show_panel) {
+  if (show_panel && w > 3 * kPanelWidth) {
     // Move the mobile right by half the panel's width so the panel does not hide it.
     const double m_per_px = 2 * c.distance * std::tan(c.fov_y / 2) / std::max(h, 1);
     c.pan(-kPanelWidth / 2 * m_per_px, 0);

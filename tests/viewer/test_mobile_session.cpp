@@ -1,0 +1,167 @@
+// The viewer's session without a window: reload on change (a broken file keeps the old mobile running),
+// drag-and-drop loads, recompiling with another total mass, the mouse spring and physics pacing.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mobile_session.hpp"
+
+namespace aloft::view {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Write `text` and move the file's modification time on by `seconds`, so a reload sees a change even on
+// file systems with coarse timestamps.
+void write_later(const fs::path& p, const std::string& text, int seconds) {
+  std::ofstream(p, std::ios::binary) << text;
+  fs::last_write_time(p, fs::last_write_time(p) + std::chrono::seconds(seconds));
+}
+
+class Session : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("aloft-session-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    fish_text_ = read(fs::path(ALOFT_SOURCE_DIR) / "mobiles/steel-fish.json");
+    fish_ = dir_ / "fish.json";
+    std::ofstream(fish_, std::ios::binary) << fish_text_;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_, fish_;
+  std::string fish_text_;
+};
+
+TEST_F(Session, BrokenReloadKeepsTheOldMobileRunningAndFixedReloadReplacesIt) {
+  // Balance "none": the Steel Fish as built swings, so "running" shows in its motion too.
+  MobileSession session(fish_.string(), BuildSettings{BalanceMode::None, {}, {}, {}, {}});
+  EXPECT_FALSE(session.reload_if_changed()) << "nothing changed yet";
+  session.advance(0.05, 1e9);
+  const int generation = session.model_generation();
+  const State before = session.simulation().state();
+  EXPECT_NEAR(before.time, 0.05, 1e-9);  // whole 1 ms steps: 50 of them
+
+  // The designer saves a file with a syntax error (cut in the middle).
+  write_later(fish_, fish_text_.substr(0, fish_text_.size() / 2), 2);
+  EXPECT_TRUE(session.reload_if_changed());
+  EXPECT_NE(session.error().find(fish_.string()), std::string::npos) << session.error();
+  EXPECT_EQ(session.model().name, "Steel Fish");
+  EXPECT_EQ(session.model_generation(), generation) << "the old model must stay";
+  EXPECT_FALSE(session.reload_if_changed()) << "a broken file is read once, not every poll";
+
+  // The old mobile keeps moving.
+  session.advance(0.05, 1e9);
+  const State& after = session.simulation().state();
+  EXPECT_NEAR(after.time, 0.10, 1e-9);
+  double moved = 0;
+  for (int i = 1; i < session.model().count; ++i) moved = std::max(moved, (after.position[i] - before.position[i]).norm());
+  // Released off balance, the lowest pieces fall away from the drawn pose at g/2 t^2 scale: over 0.05 s
+  // well above 1e-7 m (the motion is millimetres by t = 0.1 s).
+  EXPECT_GT(moved, 1e-7);
+
+  // A fixed file (renamed mobile) replaces it, from rest, and the error goes.
+  std::string renamed = fish_text_;
+  renamed.replace(renamed.find("Steel Fish"), 10, "Steel Carp");
+  write_later(fish_, renamed, 4);
+  EXPECT_TRUE(session.reload_if_changed());
+  EXPECT_EQ(session.error(), "");
+  EXPECT_EQ(session.model().name, "Steel Carp");
+  EXPECT_EQ(session.model_generation(), generation + 1);
+  EXPECT_EQ(session.simulation().state().time, 0.0);
+}
+
+TEST_F(Session, ErrorsNameTheFileAndPlace) {
+  MobileSession session(fish_.string());
+  // A negative radius: a meaning error with a JSON path and a line.
+  std::string bad = fish_text_;
+  bad.replace(bad.find("\"radius\": 0.012"), 15, "\"radius\": -0.012");
+  const fs::path other = dir_ / "bad.json";
+  std::ofstream(other, std::ios::binary) << bad;
+  EXPECT_FALSE(session.load(other.string()));
+  EXPECT_NE(session.error().find("bad.json:"), std::string::npos) << session.error();
+  EXPECT_NE(session.error().find("radius"), std::string::npos) << session.error();
+  EXPECT_EQ(session.path(), fish_.string()) << "the dropped broken file is not adopted";
+
+  EXPECT_FALSE(session.load((dir_ / "missing.json").string()));
+  EXPECT_NE(session.error().find("missing.json"), std::string::npos) << session.error();
+  EXPECT_EQ(session.model().name, "Steel Fish");
+}
+
+TEST_F(Session, DroppedFileReplacesTheMobile) {
+  MobileSession session(fish_.string());
+  const std::string cross = (fs::path(ALOFT_SOURCE_DIR) / "mobiles/southern-cross.json").string();
+  EXPECT_TRUE(session.load(cross));
+  EXPECT_EQ(session.path(), cross);
+  EXPECT_EQ(session.model().name, "Southern Cross");
+}
+
+TEST_F(Session, TotalMassRecompilesAndKeepsTheMotion) {
+  MobileSession session(fish_.string());
+  const Model before = session.model();
+  session.advance(0.02, 1e9);
+  BuildSettings doubled = session.build_settings();
+  doubled.total_mass = 2 * before.balance.total_mass;
+  ASSERT_TRUE(session.rebuild(doubled)) << session.error();
+  // Balance by mass is linear in the total: every derived mass doubles (to rounding).
+  for (int i = 1; i < before.count; ++i) EXPECT_NEAR(session.model().mass[i], 2 * before.mass[i], 1e-12 * before.mass[i]);
+  EXPECT_NEAR(session.simulation().state().time, 0.02, 1e-12) << "same geometry: the state carries over";
+
+  BuildSettings bad = doubled;
+  bad.total_mass = -1;
+  EXPECT_FALSE(session.rebuild(bad));
+  EXPECT_FALSE(session.error().empty());
+  EXPECT_NEAR(session.model().balance.total_mass, 2 * before.balance.total_mass, 1e-12);
+}
+
+TEST_F(Session, GrabSpringPullsTheComponentTowardsTheCursor) {
+  MobileSession session(fish_.string());  // balanced: at rest it does not move by itself
+  const int c = session.model().count - 1;  // the last piece in depth-first order: a leaf
+  const Vec3 start = session.simulation().state().position[c];
+  const Vec3 pull(0.1, 0, 0);              // 10 cm sideways
+  session.grab(Grab{c, Vec3::Zero(), start + pull});
+  EXPECT_GT(session.grab_force().dot(pull), 0);
+  for (int i = 0; i < 30; ++i) session.advance(1.0 / 60, 1e9);
+  const Vec3 moved = session.simulation().state().position[c] - start;
+  // After 0.5 s the spring has moved the piece a good part of the way (a free end of a mobile is soft
+  // sideways: its pendulum stiffness m g / L is far below the spring's); 2 cm is a fifth of the pull.
+  EXPECT_GT(moved.dot(pull.normalized()), 0.02);
+  session.release();
+  EXPECT_EQ(session.grab_force(), Vec3::Zero());
+}
+
+TEST_F(Session, PacingFollowsTheWallClockAndTheTimeScale) {
+  MobileSession session(fish_.string());
+  const double h = session.simulation().timestep();
+  EXPECT_NEAR(session.advance(0.05, 1e9), 0.05, h);   // real time, to a step
+  session.time_scale = 0.25;
+  EXPECT_NEAR(session.advance(0.04, 1e9), 0.01, h);   // slow motion
+  session.time_scale = 1;
+  EXPECT_NEAR(session.advance(5.0, 1e9), 0.1, h);     // a stall does not cause a jump: 0.1 s at most
+  session.paused = true;
+  EXPECT_EQ(session.advance(0.05, 1e9), 0.0);
+  const double t = session.simulation().state().time;
+  session.single_step();
+  EXPECT_NEAR(session.simulation().state().time - t, h, 1e-12);
+  session.reset();
+  EXPECT_EQ(session.simulation().state().time, 0.0);
+}
+
+}  // namespace
+}  // namespace aloft::view
