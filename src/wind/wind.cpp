@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "aloft/geometry.hpp"
 #include "wind/item_rasterizer.hpp"
@@ -247,7 +248,8 @@ void Wind::refresh_occlusion(const State& state) {
     }
   }
   buffer_.width = width;
-  buffer_.ids = ids;
+  // Hand the ids over without copying; the rasterizer refills the old buffer at the next refresh.
+  std::swap(buffer_.ids, raster.ids());
 }
 
 void Wind::apply(const State& state, double v0, double dt, ExternalLoads& loads) {
