@@ -10,6 +10,9 @@
 //   4. factor             children-first block LDL^T of the joint KKT matrix at the new pose, O(n)
 //   5. velocity projection  RATTLE: velocities projected (mass-weighted) onto the joints' tangent space
 //   6. check              stop with a report if any component's state is not finite
+// Collisions enter between 2 and 3: the contacts found at the current pose (speculatively: pairs that
+// could close their gap within the step) receive impulses solved together with the joints, with
+// restitution and Coulomb friction, before the drift (dynamics/contact_response.hpp).
 // Where the joint impulses do not converge (a thin wire spinning fast), the step is halved, recursively.
 // Steps 2-5 are the constrained symplectic Euler method (Hairer, Lubich & Wanner, Geometric Numerical
 // Integration, VII.1): first order, symplectic for the translational part, so energy does not drift.
@@ -19,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "aloft/collision.hpp"
 #include "aloft/state.hpp"
 
 namespace aloft {
@@ -37,6 +41,16 @@ struct ExternalLoads {
   std::vector<Vec3> torque;   // N m, about the centre of mass
   void resize(int count);
   void clear();
+};
+
+// Running totals of the collision response since the simulation started.
+struct CollisionStatistics {
+  long long steps_with_contacts = 0;  // (sub)steps in which the detector reported contacts
+  long long impulses = 0;             // contact impulses applied (one per active contact per step)
+  long long sliding = 0;              // of those, sliding on the friction cone's edge
+  long long restitution_dropped = 0;  // steps where bouncing would have added energy (solved with e = 0)
+  double energy_removed = 0;          // J of kinetic energy the impulses took out (>= 0)
+  double deepest = 0;                 // m, largest overlap seen at the start of a step
 };
 
 struct StepWorkspace;  // solver factorization and scratch (dynamics/simulation.cpp)
@@ -68,6 +82,14 @@ class Simulation {
   // Air damping rates (1/s); default from the model.
   void set_damping(const DampingSpec& damping) { damping_ = damping; }
 
+  // Collisions: on when the model's contact settings say so; contacts() are those of the last step.
+  void set_collisions(bool enabled);
+  bool collisions() const { return collisions_; }
+  const std::vector<Contact>& contacts() const;
+  const CollisionStatistics& collision_statistics() const { return collision_stats_; }
+  // The detector (for its pair pruning), or null when collisions are off.
+  const CollisionDetector* collision_detector() const;
+
   const std::optional<SimulationFailure>& failure() const { return failure_; }
   long long step_count() const { return steps_; }
   // How many times a step had to be halved because the motion was too fast for it.
@@ -83,6 +105,8 @@ class Simulation {
   ExternalLoads loads_;
   double timestep_;
   DampingSpec damping_;
+  bool collisions_ = false;
+  CollisionStatistics collision_stats_;
   std::optional<SimulationFailure> failure_;
   long long steps_ = 0;
   std::unique_ptr<StepWorkspace> work_;  // sized once; step() never allocates

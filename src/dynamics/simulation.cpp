@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "dynamics/contact_response.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace aloft {
@@ -30,6 +31,10 @@ constexpr int kMaxSubdivision = 8;
 // O(turn^3); 0.05 rad keeps that below 1e-4 of the turn. A mobile swinging at a few rad/s turns ~0.005
 // rad per 1 ms step; a thin wire flung into a spin at hundreds of rad/s gets its step divided.
 constexpr double kMaxTurnPerStep = 0.05;
+// Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
+// millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
+// list from one step to the next without testing pieces that are far apart.
+constexpr double kContactMargin = 5e-4;
 
 }  // namespace
 
@@ -45,7 +50,9 @@ struct StepWorkspace {
         step_impulse(model.count, Vec3::Zero()),
         drift_map(model.count, Mat3::Identity()),
         older_impulse(model.count, Vec3::Zero()),
-        rotation(model.count, Mat3::Identity()) {
+        rotation(model.count, Mat3::Identity()),
+        response(model),
+        pseudo(model.count, Vec6::Zero()) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
   }
   TreeSolver solver;
@@ -63,6 +70,11 @@ struct StepWorkspace {
   double older_step = 0;         // and the one of older_impulse
   std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
   long long subdivisions = 0;    // how many times a step was halved
+  // Collisions.
+  std::unique_ptr<CollisionDetector> detector;  // null while collisions are off
+  std::vector<Contact> contacts;  // found at the start of the last (sub)step
+  ContactResponse response;
+  std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
 };
 
 namespace {
@@ -97,7 +109,18 @@ Simulation::Simulation(const Model& model, State initial)
   loads_.resize(model.count);
   work_->next = state_;
   work_->rotation[0] = state_.orientation[0].toRotationMatrix();
+  set_collisions(model.contact.enabled);
 }
+
+void Simulation::set_collisions(bool enabled) {
+  collisions_ = enabled;
+  if (enabled && !work_->detector) work_->detector = std::make_unique<CollisionDetector>(model_);
+  if (!enabled) work_->contacts.clear();
+}
+
+const std::vector<Contact>& Simulation::contacts() const { return work_->contacts; }
+
+const CollisionDetector* Simulation::collision_detector() const { return work_->detector.get(); }
 
 Simulation::~Simulation() = default;
 
@@ -177,6 +200,17 @@ bool Simulation::rattle(double h) {
     next.angular[i] = now.angular[i] + inverse_inertia[i] * f[i].tail<3>();
   }
 
+  // Collisions: impulses on the half-step velocities for the contacts at the current pose, solved with
+  //    the joints, and the split-impulse pseudo-velocity that pushes overlaps apart in the drift below.
+  bool has_pseudo = false;
+  ContactStepReport contact_report;
+  if (collisions_) {
+    work.detector->find_contacts(now, h, kContactMargin, work.contacts);
+    if (!work.contacts.empty())
+      contact_report =
+          work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
+  }
+
   // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
   // the implicit midpoint of that flow: q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
   // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
@@ -202,8 +236,14 @@ bool Simulation::rattle(double h) {
       next.position[i] = now.position[i] + h * next.velocity[i];
       next.orientation[i] =
           (rotation_quaternion(h * (work.drift_map[i] * next.angular[i])) * now.orientation[i]).normalized();
-      work.rotation[i] = next.orientation[i].toRotationMatrix();
     }
+    if (has_pseudo) {
+      for (int i = 1; i < n; ++i) {
+        next.position[i] += h * work.pseudo[i].head<3>();
+        next.orientation[i] = (rotation_quaternion(h * work.pseudo[i].tail<3>()) * next.orientation[i]).normalized();
+      }
+    }
+    for (int i = 1; i < n; ++i) work.rotation[i] = next.orientation[i].toRotationMatrix();
     for (int i = 1; i < n; ++i) {
       const int p = parent[i];
       const Vec3 gap = (next.position[p] + work.rotation[p] * model_.joint_in_parent[i]) -
@@ -254,6 +294,15 @@ bool Simulation::rattle(double h) {
   next.time = now.time + h;
   std::swap(state_, next);
   work.factored = true;
+  if (contact_report.contacts > 0) {
+    CollisionStatistics& stats = collision_stats_;
+    ++stats.steps_with_contacts;
+    stats.impulses += contact_report.active;
+    stats.sliding += contact_report.sliding;
+    stats.restitution_dropped += contact_report.restitution_dropped;
+    stats.energy_removed -= std::min(0.0, contact_report.energy_change);
+    stats.deepest = std::max(stats.deepest, contact_report.deepest);
+  }
   return true;
 }
 
