@@ -20,6 +20,12 @@ constexpr float kRoomSpecular = 0.03f, kRoomShininess = 8.0f;       // matt pain
 // Soft-shadow filter radius as a fraction of the shadow map's width (with 1024 texels: 2.5 texels).
 constexpr float kShadowRadius = 0.0025f;
 
+// The shader lights in linear space; the file's colours are sRGB.
+float srgb_to_linear(float c) { return std::pow(c, 2.2f); }
+void set_color(GLint location, const float* srgb) {
+  glUniform3f(location, srgb_to_linear(srgb[0]), srgb_to_linear(srgb[1]), srgb_to_linear(srgb[2]));
+}
+
 void set_mat4(GLint location, const Mat4f& m) { glUniformMatrix4fv(location, 1, GL_FALSE, m.data()); }
 void set_vec3(GLint location, const Vec3& v) {
   glUniform3f(location, static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()));
@@ -66,13 +72,14 @@ OrbitCamera framing_camera(const SceneMesh& scene, double aspect) {
 
 struct Renderer::Impl {
   bool gles;
-  GlProgram lit;
+  std::unique_ptr<GlProgram> lit[2][2];   // [room][shadows]: compiled variants of the lit shader
   GlProgram depth;
   GlProgram line;
   SceneMesh scene;
   Room room;
   std::vector<float> colors;               // per component, sRGB
   std::vector<std::pair<int, int>> ranges; // per component: first vertex, vertex count
+  std::vector<Bounds> body_bounds;         // per component, body frame, m
   GLuint mobile_vao = 0, mobile_vbo = 0;
   GLuint room_vao = 0, room_vbo = 0;
   int room_vertices = 0;
@@ -82,12 +89,17 @@ struct Renderer::Impl {
 
   explicit Impl(bool gles_)
       : gles(gles_),
-        lit(shaders::glsl_source(shaders::kLitVertex, gles_), shaders::glsl_source(shaders::kLitFragment, gles_),
-            "lit"),
         depth(shaders::glsl_source(shaders::kDepthVertex, gles_),
               shaders::glsl_source(shaders::kDepthFragment, gles_), "shadow"),
         line(shaders::glsl_source(shaders::kLineVertex, gles_), shaders::glsl_source(shaders::kLineFragment, gles_),
              "line") {
+    for (int room = 0; room < 2; ++room)
+      for (int shadows = 0; shadows < 2; ++shadows) {
+        const std::string defines = std::string(room ? "#define ROOM\n" : "") + (shadows ? "#define SHADOWS\n" : "");
+        lit[room][shadows] = std::make_unique<GlProgram>(shaders::glsl_source(shaders::kLitVertex, gles_, defines),
+                                                         shaders::glsl_source(shaders::kLitFragment, gles_, defines),
+                                                         "lit");
+      }
     glGenVertexArrays(1, &mobile_vao);
     glGenBuffers(1, &mobile_vbo);
     glGenVertexArrays(1, &room_vao);
@@ -152,6 +164,43 @@ struct Renderer::Impl {
     return perspective(2 * half_angle, 1.0, near, far) * look_at(room.light_position, room.light_target, Vec3::UnitY());
   }
 
+  // The screen rectangle (x, y, width, height in pixels) that holds the mobile's shadow on the floor and
+  // the wall: every corner of every component's box, sent from the light onto the first of the two
+  // planes it meets, projected, plus a margin for the soft edge. Empty when nothing casts there; the
+  // whole screen when a corner is behind the camera (the rectangle would be unbounded).
+  std::array<int, 4> shadow_rectangle(const State& state, const Mat4f& view_proj, int width, int height) const {
+    const std::array<int, 4> whole{0, 0, width, height};
+    double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
+    const Vec3 light = room.light_position;
+    const int n = std::min<int>(static_cast<int>(body_bounds.size()), static_cast<int>(state.position.size()));
+    for (int i = 0; i < n; ++i) {
+      const Bounds& b = body_bounds[i];
+      if (b.min.x() > b.max.x()) continue;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 local((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
+                         (corner & 4) ? b.max.z() : b.min.z());
+        const Vec3 p = state.position[i] + state.orientation[i] * local;
+        const Vec3 d = p - light;
+        // Distances along the ray to the floor (y = floor_y) and the wall (z = wall_z); the first hit counts.
+        double t = 1e30;
+        if (d.y() < 0) t = std::min(t, (room.floor_y - light.y()) / d.y());
+        if (d.z() < 0) t = std::min(t, (room.wall_z - light.z()) / d.z());
+        if (t >= 1e29 || t < 1) continue;  // the shadow falls nowhere in the room
+        const Vec3 q = light + t * d;
+        const Eigen::Vector4f clip = view_proj * Eigen::Vector4f(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                                                                 static_cast<float>(q.z()), 1.0f);
+        if (clip.w() <= 1e-4f) return whole;
+        const double sx = (clip.x() / clip.w() * 0.5 + 0.5) * width, sy = (clip.y() / clip.w() * 0.5 + 0.5) * height;
+        x0 = std::min(x0, sx), x1 = std::max(x1, sx), y0 = std::min(y0, sy), y1 = std::max(y1, sy);
+      }
+    }
+    if (x0 > x1) return {0, 0, 0, 0};
+    const double margin = 0.03 * std::max(width, height);  // the filter's blur and the boxes' rounding
+    const int ax = std::clamp(static_cast<int>(x0 - margin), 0, width), bx = std::clamp(static_cast<int>(x1 + margin), 0, width);
+    const int ay = std::clamp(static_cast<int>(y0 - margin), 0, height), by = std::clamp(static_cast<int>(y1 + margin), 0, height);
+    return {ax, ay, bx - ax, by - ay};
+  }
+
   void draw_mobile(GlProgram& program, const State& state, bool with_color, int highlighted) {
     glBindVertexArray(mobile_vao);
     const int n = std::min<int>(static_cast<int>(ranges.size()), static_cast<int>(state.position.size()));
@@ -180,11 +229,14 @@ void Renderer::set_model(const Model& model) {
   std::vector<float> all;
   m.ranges.clear();
   m.colors.clear();
+  m.body_bounds.assign(model.count, Bounds{});
+  for (int i = 0; i < model.count; ++i)
+    for (const Vec3& v : m.scene.components[i].triangles.vertices) m.body_bounds[i].add(v);
   for (int i = 0; i < model.count; ++i) {
     const ComponentMesh& c = m.scene.components[i];
     m.ranges.emplace_back(static_cast<int>(all.size() / 6), c.vertex_count());
     all.insert(all.end(), c.vertices.begin(), c.vertices.end());
-    m.colors.insert(m.colors.end(), {model.color[i].r, model.color[i].g, model.color[i].b});
+    for (float c : {model.color[i].r, model.color[i].g, model.color[i].b}) m.colors.push_back(srgb_to_linear(c));
   }
   Impl::upload(m.mobile_vao, m.mobile_vbo, all);
 
@@ -235,37 +287,56 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, int width, in
   glClearColor(kBackground[0], kBackground[1], kBackground[2], 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   const Mat4f view_proj = camera.projection(static_cast<double>(width) / height) * camera.view();
-  m.lit.use();
-  set_mat4(m.lit.uniform("u_view_proj"), view_proj);
-  set_mat4(m.lit.uniform("u_light_view_proj"), light_vp);
-  set_vec3(m.lit.uniform("u_eye"), camera.eye());
-  set_vec3(m.lit.uniform("u_light_pos"), m.room.light_position);
-  set_vec3(m.lit.uniform("u_light_dir"), (m.room.light_target - m.room.light_position).normalized());
-  glUniform1i(m.lit.uniform("u_shadows"), options.shadows ? 1 : 0);
-  glUniform1f(m.lit.uniform("u_shadow_radius"), kShadowRadius);
-  glUniform2f(m.lit.uniform("u_corner"), static_cast<float>(m.room.floor_y), static_cast<float>(m.room.wall_z));
+  const auto setup = [&](GlProgram& program) {
+    program.use();
+    set_mat4(program.uniform("u_view_proj"), view_proj);
+    set_mat4(program.uniform("u_light_view_proj"), light_vp);
+    set_vec3(program.uniform("u_eye"), camera.eye());
+    set_vec3(program.uniform("u_light_pos"), m.room.light_position);
+    set_vec3(program.uniform("u_light_dir"), (m.room.light_target - m.room.light_position).normalized());
+    glUniform1f(program.uniform("u_shadow_radius"), kShadowRadius);
+    glUniform2f(program.uniform("u_corner"), static_cast<float>(m.room.floor_y), static_cast<float>(m.room.wall_z));
+    glUniform1i(program.uniform("u_shadow_map"), 0);
+  };
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, options.shadows ? m.shadow_texture : 0);
-  glUniform1i(m.lit.uniform("u_shadow_map"), 0);
+  const int shadowed = options.shadows ? 1 : 0;
 
   // The mobile first: it hides part of the room, so fewer room pixels get shaded.
-  glDisable(GL_CULL_FACE);
-  glUniform2f(m.lit.uniform("u_material"), kMobileSpecular, kMobileShininess);
-  glUniform1i(m.lit.uniform("u_room"), 0);
-  if (options.mobile) m.draw_mobile(m.lit, state, true, options.highlighted);
+  if (options.mobile) {
+    GlProgram& mobile = *m.lit[0][shadowed];
+    setup(mobile);
+    glDisable(GL_CULL_FACE);
+    glUniform2f(mobile.uniform("u_material"), kMobileSpecular, kMobileShininess);
+    m.draw_mobile(mobile, state, true, options.highlighted);
+  }
 
   if (options.room) {
+    // Shadow lookups are the costliest part of a frame on a software rasteriser, so only the rectangle
+    // where the mobile's shadow falls is drawn with them; the rest of the room after it, without (the
+    // depth test then skips what the first pass drew).
+    const auto draw_room = [&](GlProgram& room) {
+      setup(room);
+      glBindVertexArray(m.room_vao);
+      set_mat4(room.uniform("u_model"), Mat4f::Identity());
+      glUniform2f(room.uniform("u_material"), kRoomSpecular, kRoomShininess);
+      set_color(room.uniform("u_color"), kFloorColor);
+      glDrawArrays(GL_TRIANGLES, 0, 6);
+      set_color(room.uniform("u_color"), kWallColor);
+      glDrawArrays(GL_TRIANGLES, 6, 6);
+    };
     glEnable(GL_CULL_FACE);  // from behind the wall or below the floor, see through them
     glCullFace(GL_BACK);
-    glBindVertexArray(m.room_vao);
-    set_mat4(m.lit.uniform("u_model"), Mat4f::Identity());
-    glUniform2f(m.lit.uniform("u_material"), kRoomSpecular, kRoomShininess);
-    glUniform1i(m.lit.uniform("u_room"), 1);
-    glUniform1f(m.lit.uniform("u_highlight"), 0.0f);
-    glUniform3fv(m.lit.uniform("u_color"), 1, kFloorColor);
-    glDrawArrays(GL_TRIANGLES, 0, 6);
-    glUniform3fv(m.lit.uniform("u_color"), 1, kWallColor);
-    glDrawArrays(GL_TRIANGLES, 6, 6);
+    if (shadowed && options.mobile) {
+      const std::array<int, 4> r = m.shadow_rectangle(state, view_proj, width, height);
+      if (r[2] > 0 && r[3] > 0) {
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(r[0], r[1], r[2], r[3]);
+        draw_room(*m.lit[1][1]);
+        glDisable(GL_SCISSOR_TEST);
+      }
+    }
+    draw_room(*m.lit[1][0]);
     glDisable(GL_CULL_FACE);
   }
 

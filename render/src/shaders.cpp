@@ -2,10 +2,10 @@
 
 namespace aloft::render::shaders {
 
-std::string glsl_source(const char* body, bool gles) {
+std::string glsl_source(const char* body, bool gles, const std::string& defines) {
   std::string s = gles ? "#version 300 es\nprecision highp float;\nprecision highp sampler2DShadow;\n"
                        : "#version 330 core\n";
-  return s + body;
+  return s + defines + body;
 }
 
 // Lit surfaces (mobile and room). Positions in the model's frame, u_model to world.
@@ -28,31 +28,34 @@ void main() {
 }
 )";
 
+// Compiled in variants by #define (a software rasteriser such as llvmpipe runs both sides of a branch
+// under a mask, so switches are compile-time): SHADOWS (sample the shadow map), ROOM (the floor and
+// the wall: matt, darkened in their corner; otherwise the mobile: painted steel with highlights).
 // One warm key spot light with a soft shadow (percentage-closer filtering over a rotated Poisson disc,
 // each tap a hardware 2x2 comparison), a sky/ground hemisphere fill, Blinn-Phong highlights, and a
-// darkening near the floor-wall corner. Colours are given as sRGB and lit in linear space.
+// darkening near the floor-wall corner. Lit in linear space; written with a gamma of 2.
 const char* const kLitFragment = R"(
 in vec3 v_world;
 in vec3 v_normal;
 in vec4 v_light_clip;
-uniform vec3 u_color;            // sRGB 0..1
+uniform vec3 u_color;            // linear 0..1 (converted from sRGB on the CPU)
 uniform vec3 u_eye;              // world, m
 uniform vec3 u_light_pos;        // world, m
 uniform vec3 u_light_dir;        // unit, the spot's axis
 uniform sampler2DShadow u_shadow_map;
-uniform int u_shadows;           // 0 or 1
 uniform float u_shadow_radius;   // PCF radius, shadow-map texture units
 uniform vec2 u_material;         // specular strength, shininess
 uniform float u_highlight;       // 0..1: tint towards a warm glow (the grabbed component)
 uniform vec2 u_corner;           // floor height y and wall plane z (m), for the corner darkening
-uniform int u_room;              // 1 on the floor and the wall
 layout(location = 0) out vec4 o_color;
 
 // Four taps on a rotated square; each tap is a hardware 2x2 bilinear comparison, so 16 depth tests in all.
 const vec2 kTaps[4] = vec2[4](vec2(-0.9, 0.35), vec2(0.35, 0.9), vec2(0.9, -0.35), vec2(-0.35, -0.9));
 
 float lit_fraction() {
-  if (u_shadows == 0) return 1.0;
+#ifndef SHADOWS
+  return 1.0;
+#else
   vec3 p = v_light_clip.xyz / v_light_clip.w * 0.5 + 0.5;
   if (v_light_clip.w <= 0.0 || p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
   p.z = min(p.z, 1.0);   // receivers beyond the far plane (the wall) still compare against casters
@@ -66,10 +69,11 @@ float lit_fraction() {
   for (int i = 0; i < 4; ++i)
     sum += texture(u_shadow_map, vec3(p.xy + rot * kTaps[i] * u_shadow_radius, p.z));
   return sum * 0.25;
+#endif
 }
 
 void main() {
-  vec3 base = pow(u_color, vec3(2.2));
+  vec3 base = u_color;
   vec3 n = normalize(v_normal);
   vec3 v = normalize(u_eye - v_world);
   if (dot(n, v) < 0.0) n = -n;           // thin sheets seen from behind
@@ -79,20 +83,27 @@ void main() {
   float spot = smoothstep(0.45, 0.97, dot(-l, u_light_dir));   // a gallery spot: a soft pool of light
   float diffuse = max(dot(n, l), 0.0);
   vec3 h = normalize(l + v);
+#ifdef ROOM
+  float spec = 0.0;
+#else
   float spec = u_material.x * pow(max(dot(n, h), 0.0), u_material.y) * step(0.0, dot(n, l));
-  float shadow = (diffuse > 0.0 && spot > 0.0) ? lit_fraction() : 1.0;
+#endif
+  float shadow = lit_fraction();
   vec3 key = vec3(1.0, 0.95, 0.86) * 1.25 * spot * shadow;
   float sky = 0.5 + 0.5 * n.y;
   vec3 ambient = mix(vec3(0.15, 0.14, 0.13), vec3(0.30, 0.31, 0.34), sky);
-  if (u_room == 1) {
-    // Light gathers less in the corner where the floor meets the wall.
-    float d = min(v_world.y - u_corner.x, v_world.z - u_corner.y);
-    ambient *= 1.0 - 0.45 * exp(-d / 0.35);
-  }
+#ifdef ROOM
+  // Light gathers less in the corner where the floor meets the wall.
+  float d = min(v_world.y - u_corner.x, v_world.z - u_corner.y);
+  float near_corner = clamp(1.0 - d / 0.9, 0.0, 1.0);
+  ambient *= 1.0 - 0.45 * near_corner * near_corner;
+#endif
   vec3 color = base * (ambient + key * diffuse) + key * spec;
+#ifndef ROOM
   color = mix(color, vec3(1.0, 0.62, 0.2), 0.45 * u_highlight);
+#endif
   color = color / (1.0 + 0.15 * color);  // gentle roll-off of highlights
-  o_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
+  o_color = vec4(sqrt(clamp(color, 0.0, 1.0)), 1.0);   // display gamma 2 (sqrt is far cheaper than pow)
 }
 )";
 

@@ -6,8 +6,8 @@
 
 namespace aloft::render::shaders {
 
-// "#version 330 core" or "#version 300 es" + precisions, then `body`.
-std::string glsl_source(const char* body, bool gles);
+// "#version 330 core" or "#version 300 es" + precisions, then `defines` ("#define X\n" lines), then `body`.
+std::string glsl_source(const char* body, bool gles, const std::string& defines = "");
 
 extern const char* const kLitVertex;
 extern const char* const kLitFragment;

@@ -62,6 +62,7 @@ struct ViewerState {
   struct {
     long long frames = 0;
     double wall = 0, physics = 0, wind = 0, render = 0;  // s, summed
+    double cpu_start = 0;                                 // process CPU time when counting began, s
   } totals;
 
   // Input.
