@@ -80,10 +80,11 @@ void ItemRasterizer::draw_clipped(const Vec3* v, std::uint32_t id) {
   // Pixel centres (x + 0.5, y + 0.5) inside the bounding box, clamped to the buffer.
   const double lo_x = std::min({sx[0], sx[1], sx[2]}), hi_x = std::max({sx[0], sx[1], sx[2]});
   const double lo_y = std::min({sy[0], sy[1], sy[2]}), hi_y = std::max({sy[0], sy[1], sy[2]});
-  const int y0 = std::max(0, static_cast<int>(std::ceil(std::max(lo_y - 0.5, -1.0))));
-  const int y1 = std::min(width_ - 1, static_cast<int>(std::floor(std::min(hi_y - 0.5, double(width_)))));
-  const int x_lo = std::max(0, static_cast<int>(std::ceil(std::max(lo_x - 0.5, -1.0))));
-  const int x_hi = std::min(width_ - 1, static_cast<int>(std::floor(std::min(hi_x - 0.5, double(width_)))));
+  const double limit = width_;
+  const int y0 = std::max(0, static_cast<int>(std::ceil(std::clamp(lo_y - 0.5, -1.0, limit))));
+  const int y1 = std::min(width_ - 1, static_cast<int>(std::floor(std::clamp(hi_y - 0.5, -1.0, limit))));
+  const int x_lo = std::max(0, static_cast<int>(std::ceil(std::clamp(lo_x - 0.5, -1.0, limit))));
+  const int x_hi = std::min(width_ - 1, static_cast<int>(std::floor(std::clamp(hi_x - 0.5, -1.0, limit))));
   if (y0 > y1 || x_lo > x_hi) return;
   const double inv_area = 1.0 / area;
   // Edge function e_i(x, y) for the edge opposite vertex i, linear in x: e = A_i x + B_i y + C_i.
@@ -108,8 +109,9 @@ void ItemRasterizer::draw_clipped(const Vec3* v, std::uint32_t id) {
       else if (k < 0)
         to = from - 1;  // parallel to the row and outside
     }
-    const int x0 = std::max({x_lo, row_first_[y], static_cast<int>(std::ceil(std::max(from, -1.0)))});
-    const int x1 = std::min({x_hi, row_last_[y], static_cast<int>(std::floor(std::min(to, double(width_))))});
+    // Clamped to [-1, width] before the conversion to int (a nearly parallel edge gives huge bounds).
+    const int x0 = std::max({x_lo, row_first_[y], static_cast<int>(std::ceil(std::clamp(from, -1.0, double(width_))))});
+    const int x1 = std::min({x_hi, row_last_[y], static_cast<int>(std::floor(std::clamp(to, -1.0, double(width_))))});
     std::uint32_t* id_row = ids_.data() + static_cast<std::size_t>(y) * width_;
     float* depth_row = depth_.data() + static_cast<std::size_t>(y) * width_;
     for (int x = x0; x <= x1; ++x) {

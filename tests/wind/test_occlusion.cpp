@@ -59,6 +59,22 @@ TEST(WindOcclusion, OutsideTheConeOrBeforeS0GetsNothing) {
   EXPECT_LT(part, 0.5 * whole);  // less than half the plate is inside the circle of radius 0.1 m
 }
 
+TEST(WindOcclusion, PlateThroughS0IsClippedAtIt) {
+  // A 1 m plate turned 80 deg about y, centred on S0 (z = 1 m): it reaches from z = 0.5 m, between the
+  // vertex and S0, to z = 1.5 m, and its image runs far outside the buffer. Only its part beyond S0 and
+  // inside the cone feels the wind: a finite force, less than the whole plate would get face-on at 1 m.
+  const double theta = 80 * std::numbers::pi / 180;
+  const PlacedPlate plate{Vec3(0, 0, 1.0), 1.0, Vec3(std::cos(theta), 0, -std::sin(theta)), Vec3::UnitY()};
+  const Model model = plates_model({plate});
+  const Vec3 f = wind_forces(model, axis_source(), at_resolution(256), 2, rest_state(model))[1];
+  EXPECT_TRUE(f.allFinite());
+  EXPECT_GT(f.z(), 0);
+  // The cone's cross-section is at most 0.1 m in radius over z in [1, 1.5]: the pushed area is below
+  // pi 0.075^2 / cos(80 deg) = 0.1 m^2, and eq. 4 at l1 >= 1 m with cos(80 deg) caps the force at
+  // alpha v0^2 * 0.1 * cos(80 deg) = 0.08 N; the face-on plate's 1.2 * 4 * 1 N is far above.
+  EXPECT_LT(f.norm(), 0.1);
+}
+
 TEST(WindOcclusion, VisibleAreaConvergesWithResolution) {
   // A pentagon-like tilted square (edges not aligned with the pixels): the visible area must approach
   // the plate's area, 0.01 m^2, as the item buffer gets finer.
