@@ -409,6 +409,16 @@ int run_viewer(const ViewerOptions& options) {
       }
 
       ++frame;
+      // Keep the frame rate: when frames take longer than 20 ms for two seconds with anti-aliasing on (it
+      // is the costliest part of a frame on a software renderer), turn it off once and say so.
+      if (options.frames == 0 && v.samples > 1 && !v.auto_quality_done) {
+        v.slow_seconds = v.stats.frame_seconds > 0.020 ? v.slow_seconds + wall_dt : 0;
+        if (v.slow_seconds > 2) {
+          v.samples = 0;
+          v.auto_quality_done = true;
+          v.notify("anti-aliasing off to keep the frame rate (View > anti-aliasing turns it back on)");
+        }
+      }
       if (options.frames > 0 && frame >= options.frames) {
         try {
           if (!options.screenshot.empty()) render::write_png(options.screenshot, fb_w, fb_h, pixels);

@@ -56,6 +56,8 @@ struct ViewerState {
   bool show_help = false;
   bool shadows = true;
   int samples = 4;
+  bool auto_quality_done = false;    // anti-aliasing was switched off once for speed (never again)
+  double slow_seconds = 0;           // how long frames have been slower than 20 ms
   bool show_cone = false;
   bool show_occlusion = false;
   FrameStats stats;
