@@ -15,7 +15,9 @@ inline void put16(std::vector<std::uint8_t>& b, unsigned v) {
 inline void put32(std::vector<std::uint8_t>& b, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) b.push_back((v >> (8 * i)) & 0xff);
 }
-inline void put_tag(std::vector<std::uint8_t>& b, const char* tag) { b.insert(b.end(), tag, tag + 4); }
+inline void put_tag(std::vector<std::uint8_t>& b, const char* tag) {
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(tag[i]));
+}
 
 // A WAV with the given format code, channels, rate, bits and raw sample bytes; `extensible` wraps the format
 // in WAVE_FORMAT_EXTENSIBLE; `extra_chunk` adds a "LIST" chunk of 3 bytes (odd: padded) before "data".
