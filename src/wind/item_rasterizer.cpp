@@ -33,8 +33,17 @@ void ItemRasterizer::reset(int width, double half, double near) {
     }
   }
   near_ = near;
+  blocks_ = (width + kBlock - 1) / kBlock;
+  touched_.assign(static_cast<std::size_t>(blocks_) * blocks_, 0);
   ids_.assign(n, 0);
   depth_.assign(n, 0.0f);
+}
+
+bool ItemRasterizer::any_touched(int x0, int y0, int x1, int y1) const {
+  for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+    for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx)
+      if (touched_[static_cast<std::size_t>(by) * blocks_ + bx]) return true;
+  return false;
 }
 
 void ItemRasterizer::draw(const Vec3& a, const Vec3& b, const Vec3& c, std::uint32_t id) {
@@ -114,6 +123,7 @@ void ItemRasterizer::draw_clipped(const Vec3* v, std::uint32_t id) {
     const int x1 = std::min({x_hi, row_last_[y], static_cast<int>(std::floor(std::clamp(to, -1.0, double(width_))))});
     std::uint32_t* id_row = ids_.data() + static_cast<std::size_t>(y) * width_;
     float* depth_row = depth_.data() + static_cast<std::size_t>(y) * width_;
+    std::uint8_t* touched_row = touched_.data() + static_cast<std::size_t>(y / kBlock) * blocks_;
     for (int x = x0; x <= x1; ++x) {
       const double px = x + 0.5;
       const double e0 = ea[0] * px + eb[0] * py + ec[0];
@@ -124,6 +134,7 @@ void ItemRasterizer::draw_clipped(const Vec3* v, std::uint32_t id) {
       if (depth > depth_row[x]) {
         depth_row[x] = depth;
         id_row[x] = id;
+        touched_row[x / kBlock] = 1;
       }
     }
   }

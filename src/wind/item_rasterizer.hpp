@@ -31,6 +31,13 @@ class ItemRasterizer {
   int row_first(int y) const { return row_first_[y]; }
   int row_last(int y) const { return row_last_[y]; }
 
+  // Whether any pixel of the kBlock x kBlock block containing pixel (x, y) was written since reset()
+  // (lets the caller skip empty parts of the buffer).
+  static constexpr int kBlock = 8;
+  bool touched(int x, int y) const { return touched_[static_cast<std::size_t>(y / kBlock) * blocks_ + x / kBlock] != 0; }
+  // Whether any block overlapping pixels [x0, x1] x [y0, y1] (inclusive) was written.
+  bool any_touched(int x0, int y0, int x1, int y1) const;
+
   std::vector<std::uint32_t>& ids() { return ids_; }
   const std::vector<std::uint32_t>& ids() const { return ids_; }
 
@@ -42,6 +49,8 @@ class ItemRasterizer {
   std::vector<std::uint32_t> ids_;
   std::vector<float> depth_;   // 1/z of the nearest surface so far; 0: none
   std::vector<int> row_first_, row_last_;
+  int blocks_ = 0;                      // blocks per row
+  std::vector<std::uint8_t> touched_;   // per block
 };
 
 }  // namespace aloft::internal

@@ -194,6 +194,7 @@ void Wind::refresh_occlusion(const State& state) {
   plane_d_.resize(triangle_component_.size() + 1);
   for (int ty = 0; ty < width; ty += tile) {
     for (int tx = 0; tx < width; tx += tile) {
+      if (!raster.any_touched(tx, ty, std::min(width, tx + tile) - 1, std::min(width, ty + tile) - 1)) continue;
       local.clear();
       for (int y = ty; y < std::min(width, ty + tile); ++y) {
         const int x0 = std::max(tx, raster.row_first(y));
