@@ -1,5 +1,5 @@
-// General convex contact through libccd (GJK to find the overlap, EPA for depth, direction and point),
-// and the dispatch between it and the closed forms.
+// General convex contact: GJK distance (gjk_distance.cpp) when the pieces are apart, libccd's GJK + EPA
+// when they overlap; and the dispatch between it and the closed forms.
 //
 // Speculative distance: each piece is inflated by margin / 2 (its support moves margin / 2 along the
 // query direction: a Minkowski sum with a ball). For convex pieces the inflated signed distance is the
@@ -9,8 +9,10 @@
 
 #include <ccd/ccd.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "collision/gjk_distance.hpp"
 #include "collision/narrow_phase.hpp"
 
 namespace aloft::internal {
@@ -58,6 +60,27 @@ ccd_t make_ccd() {
 
 bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                  double margin, PieceContact& out) {
+  // Apart: GJK distance gives the closest points themselves. A sphere enters as its centre (its core)
+  // and its radius is taken off afterwards: GJK on a point and a polytope ends in finitely many steps,
+  // on a round support it only converges.
+  auto core = [](const ConvexPiece& p) {
+    ConvexPiece c = p;
+    if (c.kind == ConvexPiece::Kind::Sphere) c.radius = 0;
+    return c;
+  };
+  const double ra = a.kind == ConvexPiece::Kind::Sphere ? a.radius : 0.0;
+  const double rb = b.kind == ConvexPiece::Kind::Sphere ? b.radius : 0.0;
+  const GjkResult g = (ra > 0 || rb > 0) ? gjk_distance(core(a), pose_a, core(b), pose_b)
+                                          : gjk_distance(a, pose_a, b, pose_b);
+  if (!g.overlap && g.distance > ra + rb) {
+    const double gap = g.distance - ra - rb;
+    if (!(gap < margin)) return false;
+    out.normal = (g.on_a - g.on_b) / g.distance;
+    out.distance = gap;
+    out.point = 0.5 * ((g.on_a - ra * out.normal) + (g.on_b + rb * out.normal));
+    return true;
+  }
+  // Overlapping: libccd's EPA on the pieces inflated by margin / 2 each (see the top of this file).
   static const ccd_t ccd = make_ccd();
   const Inflated ia{&a, &pose_a, 0.5 * margin}, ib{&b, &pose_b, 0.5 * margin};
   ccd_real_t depth = 0;
@@ -67,13 +90,13 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   if (ccdGJKPenetration(&ia, &ib, &ccd, &depth, &dir, &pos) != 0) return false;
   Vec3 n(-dir.v[0], -dir.v[1], -dir.v[2]);
   const double len = n.norm();
-  if (!(len > 0) || !std::isfinite(depth)) return false;  // EPA degenerate: touching at exactly margin
+  if (!(len > 0) || !std::isfinite(depth)) return false;  // EPA degenerate
   out.normal = n / len;
   // libccd's EPA stops 1e-5..1e-4 m short on curved supports (spheres, wire rims, the inflation
   // itself). The gap along any unit n, min over a of a.n - max over b of b.n, is at most the signed
   // distance (which is its maximum over n), and is within second order of the normal's error of it:
   // so take the gap along EPA's normal from the true supports. Conservative: never larger than the
-  // true distance, so a contact within the margin is never missed.
+  // true distance.
   const Vec3 on_a = pose_a.to_world(a.support(pose_a.rotation.transpose() * -out.normal));
   const Vec3 on_b = pose_b.to_world(b.support(pose_b.rotation.transpose() * out.normal));
   out.distance = std::min(margin - static_cast<double>(depth), (on_a - on_b).dot(out.normal));

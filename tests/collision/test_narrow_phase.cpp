@@ -113,11 +113,9 @@ TEST(NarrowPhase, WireEndGoesToGjkAndMatchesSampling) {
   EXPECT_FALSE(cylinder_cylinder_sides(a.from, a.to, a.radius, b.from, b.to, b.radius, c));
   const auto g = contact(a, b, 0.042);
   ASSERT_TRUE(g);
-  // libccd's EPA on curved supports is good to ~1e-4 m and 2 % in the normal (measured: 1.3e-5 m here);
-  // the reported gap is the gap along EPA's normal, never more than the true one.
-  EXPECT_NEAR(g->distance, 0.04, 1e-4);
-  EXPECT_LE(g->distance, 0.04 + 1e-12);
-  EXPECT_NEAR(g->normal.y(), 1, 2e-4);     // a is above b; 2e-4 = 1 - cos(2 %)
+  // GJK on two round supports converges to a relative 1e-12 of the squared distance: ~1e-8 m here.
+  EXPECT_NEAR(g->distance, 0.04, 1e-7);
+  EXPECT_NEAR(g->normal.y(), 1, 1e-9);     // a is above b
 }
 
 Plate square_plate(double half, double thickness) {
@@ -140,13 +138,12 @@ TEST(NarrowPhase, PlateSphereThroughGjkMatchesPointDistance) {
     if (gap < 1e-4) continue;
     const auto g = contact(Sphere{c, r}, plate, gap + 0.002);  // a margin of a few mm, as in a step
     ASSERT_TRUE(g) << k;
-    // EPA on a curved support: ~1e-4 m (measured up to 5.5e-5 m here), conservative (gap along its normal).
-    EXPECT_NEAR(g->distance, gap, 1e-4) << k;
-    EXPECT_LE(g->distance, gap + 1e-12) << k;
+    // Apart, the sphere's centre against the plate part: GJK on a point and a polytope is exact up to
+    // round-off (1e-12 m allows for a few operations on metre-sized coordinates).
+    EXPECT_NEAR(g->distance, gap, 1e-12) << k;
     // Normal from the plate (b) towards the sphere (a): stepping back from the centre by the gap + r
-    // along it lands on the plate, to within the normal's error times that length: libccd's EPA normal
-    // on a curved support was measured up to 4.5 % off here, so 5 %.
-    EXPECT_LT(distance_to_shape(plate, c - (gap + r) * g->normal), 0.05 * (gap + r)) << k;
+    // along it lands on the plate.
+    EXPECT_NEAR(distance_to_shape(plate, c - (gap + r) * g->normal), 0, 1e-9) << k;
   }
 }
 
@@ -155,7 +152,10 @@ TEST(NarrowPhase, PlateSphereOverlapDepthAndNormal) {
   // A ball of radius 0.01 resting 0.003 into the top face (y = +0.002): depth 0.003, normal +y.
   const auto g = contact(Sphere{Vec3(0.05, 0.002 + 0.007, 0.03), 0.01}, plate, 0.001);
   ASSERT_TRUE(g);
-  EXPECT_NEAR(g->distance, -0.003, 1e-4);  // EPA on a curved support, as above
+  // Overlapping: libccd's EPA, which stops 1e-5..1e-4 m short on curved supports (the inflation makes
+  // every support round); the distance is the gap along EPA's normal, never more than the true one.
+  EXPECT_NEAR(g->distance, -0.003, 1e-4);
+  EXPECT_LE(g->distance, -0.003 + 1e-12);
   EXPECT_NEAR(g->normal.y(), 1, 2e-4);
   // Same with the roles swapped: the normal flips (still from b towards a).
   const auto h = contact(plate, Sphere{Vec3(0.05, 0.009, 0.03), 0.01}, 0.001);
@@ -170,16 +170,16 @@ TEST(NarrowPhase, PlateWireAndPlatePlate) {
   const Wire w{Vec3(-0.3, 0.002 + 0.02 + 0.005, 0), Vec3(0.3, 0.027, 0.1), 0.005};
   const auto g = contact(w, plate, 0.022);
   ASSERT_TRUE(g);
-  EXPECT_NEAR(g->distance, 0.02, 1e-4);  // EPA, as above
-  EXPECT_NEAR(g->normal.y(), 1, 2e-4);
+  EXPECT_NEAR(g->distance, 0.02, 1e-7);  // GJK on a round support (the wire): as for two wires
+  EXPECT_NEAR(g->normal.y(), 1, 1e-9);
   // A vertical plate whose lower edge is 0.01 above the horizontal one.
   Plate upright = square_plate(0.1, 0.002);
   upright.v_axis = Vec3::UnitY();
   upright.origin = Vec3(0, 0.002 + 0.01 + 0.1, 0);
   const auto h = contact(upright, plate, 0.012);
   ASSERT_TRUE(h);
-  EXPECT_NEAR(h->distance, 0.01, 1e-4);
-  EXPECT_NEAR(h->normal.y(), 1, 2e-4);
+  EXPECT_NEAR(h->distance, 0.01, 1e-12);  // two polytopes: GJK is exact up to round-off
+  EXPECT_NEAR(h->normal.y(), 1, 1e-12);
   EXPECT_FALSE(contact(upright, plate, 0.005));  // gap 0.01 is not below a 0.005 margin
 }
 
@@ -197,7 +197,7 @@ TEST(NarrowPhase, ConcavePlateHasNoContactInItsNotch) {
   EXPECT_FALSE(contact(ball, u, 0.02));  // gap 0.04 > margin 0.02: no contact, the hull would overlap
   const auto g = contact(ball, u, 0.042);
   ASSERT_TRUE(g);
-  EXPECT_NEAR(g->distance, 0.04, 1e-4);  // EPA, as above
+  EXPECT_NEAR(g->distance, 0.04, 1e-12);  // point (sphere core) against polytopes: exact up to round-off
   EXPECT_NEAR(distance_to_shape(u, ball.center) - ball.radius, 0.04, 1e-12);
 }
 
@@ -236,12 +236,12 @@ TEST(NarrowPhase, BoxAndMeshPieces) {
   const Sphere ball{Vec3(0.2, 0.5 + 0.1 + 0.05, -0.1), 0.05};
   const auto g = contact(ball, box, 0.102);
   ASSERT_TRUE(g);
-  EXPECT_NEAR(g->distance, 0.1, 1e-4);  // EPA, as above
-  EXPECT_NEAR(g->normal.y(), 1, 2e-4);
+  EXPECT_NEAR(g->distance, 0.1, 1e-12);  // point against a polytope: exact up to round-off
+  EXPECT_NEAR(g->normal.y(), 1, 1e-12);
   const Mesh mesh{"box.obj", shape_mesh(box)};
   const auto m = contact(ball, mesh, 0.102);
   ASSERT_TRUE(m);
-  EXPECT_NEAR(m->distance, 0.1, 1e-4);
+  EXPECT_NEAR(m->distance, 0.1, 1e-12);
   EXPECT_EQ(pieces_of(mesh).size(), mesh.mesh.triangles.size());
 }
 

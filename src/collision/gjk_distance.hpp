@@ -1,0 +1,20 @@
+#pragma once
+// GJK distance (Gilbert, Johnson and Keerthi 1988; closest points on the simplex after Ericson, Real-Time
+// Collision Detection 5.1): the closest points of two convex pieces that do not overlap. libccd 2.0
+// offers intersection and penetration (EPA) but no distance, and its EPA is coarse on curved supports,
+// so separated pairs (the usual speculative contact) are measured here and only overlaps go to EPA.
+
+#include "collision/narrow_phase.hpp"
+
+namespace aloft::internal {
+
+struct GjkResult {
+  bool overlap = false;          // the pieces intersect (or are closer than round-off)
+  Vec3 on_a = Vec3::Zero();      // closest point on a, world (when !overlap)
+  Vec3 on_b = Vec3::Zero();      // closest point on b, world
+  double distance = 0;           // |on_a - on_b|, m
+};
+
+GjkResult gjk_distance(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b);
+
+}  // namespace aloft::internal
