@@ -7,8 +7,9 @@
 // - Continuity (eq. 2): the speed at distance l1 >= l0 from the vertex is v1 = v0 (l0 / l1)^2.
 // - Drag (eqs. 3-4) on an element of area A, unit normal n_a, wind direction n_v (the ray from the vertex):
 //     F = rho A v1^2 (n_v . n_a) n_a = alpha A v0^2 / l1^4 (n_v . n_a) n_a,   alpha = rho * l0^4 (kg m)
-//   (see docs/wind.md: rho A v1^2 cos^2 is the momentum flux of the air stopped by the face, i.e. a drag
-//   coefficient of 2 on the projected area). The sign of n_a does not matter; F pushes along the wind.
+//   (docs/wind.md: rho v1^2 times the projected area A cos, pushed along the normal, so the part along the
+//   wind goes as cos^2; a normal-force coefficient of 2 against rho v^2 / 2). The sign of n_a does not
+//   matter; F pushes along the wind.
 // - Turbulence (eq. 5): per component, F_random = beta |F_stoke| r(t), r(t) a random vector with |r| < 1
 //   that wanders with a correlation time (Ornstein-Uhlenbeck), so it reads as gusts, not hiss.
 // - Occlusion: only surface seen from the vertex, inside the cone and beyond S0 feels the wind. An item
@@ -21,6 +22,7 @@
 // Usage (a simulation at 1 ms steps, occlusion refreshed at 60 Hz):
 //     Wind wind(model, WindSource::aimed(from, to, r0, l0), WindSettings{});
 //     for each step: if (time to refresh) wind.refresh_occlusion(sim.state());
+//                    sim.loads().clear();                            // apply() adds to the loads
 //                    wind.apply(sim.state(), v0, dt, sim.loads());   // then sim.step()
 // Elements are kept in body frames, so between refreshes they follow their components; apply() re-checks
 // each element against the cone with the current pose. No allocation in apply().
