@@ -101,6 +101,16 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   const Vec3 on_b = pose_b.to_world(b.support(pose_b.rotation.transpose() * out.normal));
   out.distance = std::min(margin - static_cast<double>(depth), (on_a - on_b).dot(out.normal));
   out.point = Vec3(pos.v[0], pos.v[1], pos.v[2]);
+  // EPA's point is an average over its last face and can be centimetres off. Pull b back along the
+  // normal until the gap along it is 1 um, and take the closest points of that separated pair from GJK
+  // (then move b's back): the point midway between them is where the two surfaces meet.
+  if (out.distance < 0) {
+    const double pull = 1e-6 - out.distance;
+    Pose pulled = pose_b;
+    pulled.position -= pull * out.normal;
+    const GjkResult apart = gjk_distance(a, pose_a, b, pulled);
+    if (!apart.overlap) out.point = 0.5 * (apart.on_a + apart.on_b + pull * out.normal);
+  }
   return out.distance < margin;
 }
 

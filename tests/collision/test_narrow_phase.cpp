@@ -156,6 +156,9 @@ TEST(NarrowPhase, PlateSphereOverlapDepthAndNormal) {
   // every support round); the distance is the gap along EPA's normal, never more than the true one.
   EXPECT_NEAR(g->distance, -0.003, 1e-4);
   EXPECT_LE(g->distance, -0.003 + 1e-12);
+  // Point midway between the ball's lowest point (y = -0.001) and the plate's top face (y = 0.002),
+  // below the centre; 1e-4 m allows for EPA's normal error over the 0.01 m radius.
+  EXPECT_LT((g->point - Vec3(0.05, 0.0005, 0.03)).norm(), 1e-4);
   EXPECT_NEAR(g->normal.y(), 1, 2e-4);
   // Same with the roles swapped: the normal flips (still from b towards a).
   const auto h = contact(plate, Sphere{Vec3(0.05, 0.009, 0.03), 0.01}, 0.001);
