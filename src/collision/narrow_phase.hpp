@@ -8,9 +8,9 @@
 // Closed forms (exact): sphere-sphere, cylinder-sphere (flat-ended cylinder: side, rim and end faces),
 // cylinder-cylinder when the closest points of the two axes lie strictly inside both axes (side to side;
 // then exact when apart, the capsule depth when overlapping). Everything else (an end of a wire
-// involved, boxes, plate parts, mesh pieces) goes through libccd's GJK + EPA on support functions, with
-// both pieces inflated by margin / 2 (a Minkowski sum with a ball), so that a gap smaller than the
-// margin becomes an overlap of depth margin - gap: distance = margin - depth.
+// involved, boxes, plate parts, mesh pieces) goes through support functions: GJK distance
+// (gjk_distance.hpp) when apart, libccd's GJK + EPA with both pieces inflated by margin / 2 when they
+// overlap (gjk_contact.cpp).
 
 #include "collision/convex_pieces.hpp"
 
@@ -38,8 +38,8 @@ PieceContact cylinder_sphere(const Vec3& from, const Vec3& to, double rc, const 
 bool cylinder_cylinder_sides(const Vec3& from_a, const Vec3& to_a, double ra, const Vec3& from_b,
                              const Vec3& to_b, double rb, PieceContact& out);
 
-// GJK/EPA (libccd) on the pieces inflated by margin / 2 each. True, with `out`, when their signed
-// distance is below `margin` (> 0).
+// Support-function contact: GJK distance when apart, libccd's EPA when overlapping. True, with `out`,
+// when the signed distance is below `margin` (> 0).
 bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                  double margin, PieceContact& out);
 
