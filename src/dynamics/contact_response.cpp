@@ -165,4 +165,28 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   return report;
 }
 
+bool ContactResponse::correct(const std::vector<Contact>& contacts, double h, std::vector<Vec3>& velocity,
+                              std::vector<Vec3>& angular, double tolerance) {
+  const int m = static_cast<int>(contacts.size());
+  if (m == 0) return false;
+  bool needed = false;
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = contacts[k];
+    auto point_velocity = [&](int body, const Vec3& arm) -> Vec3 {
+      return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
+    };
+    u_.segment<3>(3 * k) = basis_[k].transpose() * (point_velocity(c.a, arm_a_[k]) - point_velocity(c.b, arm_b_[k]));
+    rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
+    needed = needed || u_[3 * k] < rows_[k].target_normal - tolerance;
+  }
+  if (!needed) return false;
+  solve_contact_law(K_, u_, rows_, P_);
+  respond(contacts, P_, false);
+  for (int i = 1; i < model_.count; ++i) {
+    velocity[i] += du_[i].head<3>();
+    angular[i] += du_[i].tail<3>();
+  }
+  return true;
+}
+
 }  // namespace aloft

@@ -34,7 +34,7 @@ struct ContactTuning {
   // at about g h per step, and bouncing it would make it chatter. Raised to 2 g h at run time.
   double bounce_threshold = 0.005;
   double penetration_slop = 5e-5;  // m: overlap tolerated without correction (round-off, settling)
-  double penetration_rate = 0.2;   // fraction of the overlap beyond the slop removed per step
+  double penetration_rate = 0.8;   // fraction of the overlap beyond the slop removed per step
 };
 
 // What the last resolve did (for statistics, the viewer and tests).
@@ -61,6 +61,13 @@ class ContactResponse {
   ContactStepReport resolve(const State& pose, TreeSolver& solver, const std::vector<Contact>& contacts, double h,
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
                             bool& has_pseudo);
+
+  // After the joints' impulses changed the velocities (SHAKE), make the contacts of the last resolve()
+  // hold again: the same collision matrix, targets without restitution (the bounce was given), the
+  // extra impulses applied to `velocity`/`angular`. Returns whether any impulse was needed beyond
+  // `tolerance` (m/s of normal velocity).
+  bool correct(const std::vector<Contact>& contacts, double h, std::vector<Vec3>& velocity,
+               std::vector<Vec3>& angular, double tolerance);
 
   ContactTuning tuning;
 
