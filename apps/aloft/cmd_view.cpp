@@ -40,6 +40,9 @@ Runner add_view(CLI::App& app) {
       ->check(CLI::Range(0.0, 20.0));
   sub->add_flag("--no-wind", o->no_wind, "Start with the wind off (W toggles it)");
   sub->add_flag("--no-mic", o->no_mic, "Do not open the microphone");
+  sub->add_flag("--show-cone", o->viewer.show_cone, "Show the wind's cone from the start (K toggles it)");
+  sub->add_flag("--show-occlusion", o->viewer.show_occlusion,
+                "Show what the wind reaches (the occlusion result) from the start (O toggles it)");
   o->camera.add_to(sub);
   sub->add_option("--frames", o->viewer.frames,
                   "Run exactly N frames (1/60 s of simulated time each), save --screenshot and exit")

@@ -251,6 +251,8 @@ int run_viewer(const ViewerOptions& options) {
   v.adjust_camera = options.adjust_camera;
   v.shadows = options.shadows;
   v.samples = options.samples;
+  v.show_cone = options.show_cone;
+  v.show_occlusion = options.show_occlusion;
   v.start = Clock::now();
 #if ALOFT_HAVE_WIND
   v.session->wind_control.enabled = options.wind;

@@ -23,6 +23,8 @@ struct ViewerOptions {
   std::function<render::OrbitCamera(render::OrbitCamera)> adjust_camera;
   bool wind = true;                      // the wind module (if built in) on at start
   double breeze = 0;                     // m/s, steady wind at start
+  bool show_cone = false;                // the wind cone drawn at start (K toggles it)
+  bool show_occlusion = false;           // what the wind reaches drawn at start (O toggles it)
   bool microphone = true;                // open the default capture device (its absence is fine)
 
   // Test hooks. frames > 0: run exactly that many frames with a fixed 1/60 s of simulated time per
