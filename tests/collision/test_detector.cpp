@@ -75,7 +75,9 @@ TEST(Detector, DeterministicOnTheSteelFishSwung) {
   ASSERT_EQ(c1.size(), c3.size());
   for (std::size_t k = 0; k < c1.size(); ++k) {
     EXPECT_LT(c1[k].a, c1[k].b);
-    if (k > 0) EXPECT_LE(std::pair(c1[k - 1].a, c1[k - 1].b), std::pair(c1[k].a, c1[k].b));
+    if (k > 0) {
+      EXPECT_LE(std::pair(c1[k - 1].a, c1[k - 1].b), std::pair(c1[k].a, c1[k].b));
+    }
     EXPECT_EQ(c1[k].a, c2[k].a);
     EXPECT_EQ(c1[k].b, c2[k].b);
     EXPECT_EQ(c1[k].distance, c2[k].distance);  // bit for bit
