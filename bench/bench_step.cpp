@@ -1,7 +1,9 @@
 // aloft_bench: the cost of a simulation step, and of the tree solver's factor and solve alone.
 //
-//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (bench_models.hpp): presets from
-//                        mobiles/ and generated mobiles of 15 ... 65535 components
+//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (bench_models.hpp), collisions off
+//                        (issue 2's figure): presets from mobiles/ and generated mobiles of 15 ... 65535
+//                        components
+//   BM_StepCollisions/<mobile>  the same with collisions on (issue 3's figure)
 //   BM_Factor/<mobile>   TreeSolver::factor() at a swinging pose
 //   BM_Solve/<mobile>    TreeSolver::solve() with the factorization of that pose
 //
@@ -85,11 +87,12 @@ const Model* model_or_skip(benchmark::State& state, const std::string& key) {
   return entry.model.get();
 }
 
-void BM_Step(benchmark::State& state, const std::string& key) {
+void BM_Step(benchmark::State& state, const std::string& key, bool collisions) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
   const Model& model = *found;
   aloft::Simulation sim(model, aloft::bench::swinging_state(model));
+  sim.set_collisions(collisions);
   const double start = cpu_seconds();
   for (auto _ : state) {
     if (!sim.step()) {
@@ -164,7 +167,10 @@ void register_all() {
   std::vector<std::string> keys = kPresets;
   for (int n : kGenerated) keys.push_back("generated-" + std::to_string(n));
   for (const std::string& key : keys)
-    benchmark::RegisterBenchmark(("BM_Step/" + key).c_str(), BM_Step, key)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_Step/" + key).c_str(), BM_Step, key, false)->Unit(benchmark::kMicrosecond);
+  for (const std::string& key : keys)
+    benchmark::RegisterBenchmark(("BM_StepCollisions/" + key).c_str(), BM_Step, key, true)
+        ->Unit(benchmark::kMicrosecond);
   for (const std::string& key : keys)
     benchmark::RegisterBenchmark(("BM_Factor/" + key).c_str(), BM_Factor, key)->Unit(benchmark::kMicrosecond);
   for (const std::string& key : keys)

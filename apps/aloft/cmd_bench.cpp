@@ -1,5 +1,6 @@
 // aloft bench: simulation speed (steps per second) on the preset mobiles and on generated mobiles of
-// growing size. Each mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5 repetitions of enough steps
+// growing size, without collisions (issue 2's figure) and with them (issue 3's), in the same run. Each
+// mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5 repetitions of enough steps
 // for at least 0.5 s each (or --steps); the median is reported.
 
 #include <algorithm>
@@ -50,14 +51,16 @@ std::string cpu_model() {
 struct Measurement {
   double steps_per_second = 0;
   double subdivided = 0;  // step halvings per timed step (0: no step had to be divided for a fast spin)
+  double solves = 0;      // tree solves per timed step (joint corrections + velocity projections)
   long long steps_per_repetition = 0;
   std::string failure;  // non-empty if the simulation failed
 };
 
-Measurement measure(const Model& model, long long fixed_steps) {
+Measurement measure(const Model& model, long long fixed_steps, bool collisions) {
   constexpr int kRepetitions = 5;
   Measurement out;
   Simulation sim(model);
+  sim.set_collisions(collisions);
   // Warm up with a breeze: a horizontal push of 0.2 g on every component, turning with the index, for up to
   // 0.3 s, so that the mobile swings (a balanced mobile at rest would be an unrepresentatively easy case)
   // as it would in a room's draught, at a few tenths of a radian per second.
@@ -82,6 +85,7 @@ Measurement measure(const Model& model, long long fixed_steps) {
 
   std::vector<double> rates;
   const long long subdivisions_before = sim.subdivisions();
+  const long long iterations_before = sim.joint_iterations();
   const long long steps_before = sim.step_count();
   for (int r = 0; r < kRepetitions; ++r) {
     const auto start = Clock::now();
@@ -102,18 +106,29 @@ Measurement measure(const Model& model, long long fixed_steps) {
   }
   std::sort(rates.begin(), rates.end());
   out.steps_per_second = rates[rates.size() / 2];
-  out.subdivided = static_cast<double>(sim.subdivisions() - subdivisions_before) /
-                   static_cast<double>(std::max(1LL, sim.step_count() - steps_before));
+  const double steps = static_cast<double>(std::max(1LL, sim.step_count() - steps_before));
+  const double subdivided = static_cast<double>(sim.subdivisions() - subdivisions_before);
+  out.subdivided = subdivided / steps;
+  // Every accepted (sub)step makes one velocity projection; a halving turns one step into two.
+  out.solves = (static_cast<double>(sim.joint_iterations() - iterations_before) + steps + subdivided) / steps;
   return out;
 }
 
-void print_row(const std::string& name, int components, const Measurement& m) {
-  if (!m.failure.empty()) {
-    std::printf("%-28s %10d  failed: %s\n", name.c_str(), components, m.failure.c_str());
+// One line: the collision-free figures, then those with collisions on (same mobile, same warm-up).
+void print_row(const std::string& name, int components, const Measurement& free, const Measurement& with) {
+  const int moving = std::max(1, components - 1);
+  if (!free.failure.empty()) {
+    std::printf("%-20s %6d  failed: %s\n", name.c_str(), components, free.failure.c_str());
   } else {
-    const double us = 1e6 / m.steps_per_second;
-    std::printf("%-28s %10d %12.1f %12.2f %14.4f %10.4f\n", name.c_str(), components, m.steps_per_second, us,
-                us / std::max(1, components - 1), m.subdivided);
+    const double us = 1e6 / free.steps_per_second;
+    std::printf("%-20s %6d %11.1f %10.2f %8.4f %6.2f %6.2f", name.c_str(), components, free.steps_per_second, us,
+                us / moving, free.subdivided, free.solves);
+    if (!with.failure.empty()) {
+      std::printf("   with collisions failed: %s\n", with.failure.c_str());
+    } else {
+      const double us_with = 1e6 / with.steps_per_second;
+      std::printf(" | %10.2f %8.4f %6.2f %6.2f\n", us_with, us_with / moving, with.subdivided, us_with / us);
+    }
   }
   std::fflush(stdout);
 }
@@ -129,7 +144,7 @@ Runner add_bench(CLI::App& app) {
   auto o = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "bench",
-      "Measure simulation speed on the preset mobiles and on generated ones");
+      "Measure simulation speed on the preset mobiles and on generated ones, without and with collisions");
   sub->add_option("--steps", o->steps, "Steps per repetition (>= 1; default: enough for 0.5 s)")
       ->type_name("N")
       ->check(integer_in(1, 1000000000));
@@ -142,9 +157,11 @@ Runner add_bench(CLI::App& app) {
   sub->footer(
       "Prints steps per second, microseconds per step and per moving component per step for the preset\n"
       "mobiles (steel-fish.json and southern-cross.json; a missing one is skipped with a note) and for\n"
-      "generated mobiles (seed 1). Each mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5\n"
-      "repetitions of at least 0.5 s (or --steps steps); the median is reported. \"halvings\" counts\n"
-      "how often per step the step had to be halved because something spun too fast for it.\n"
+      "generated mobiles (seed 1), first with collisions off, then (right of the bar) with collisions on.\n"
+      "Each mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5 repetitions of at\n"
+      "least 0.5 s (or --steps steps); the median is reported. \"halv\" counts how often per step the step\n"
+      "had to be halved because something spun too fast for it; \"solves\" the tree solves per step (joint\n"
+      "corrections and velocity projections); \"ratio\" the time per step with collisions over without.\n"
       "\n"
       "Examples:\n"
       "  aloft bench\n"
@@ -157,8 +174,9 @@ Runner add_bench(CLI::App& app) {
                 ALOFT_BUILD_TYPE);
     std::printf("median of 5 repetitions of %s, after a warm-up in a breeze\n\n",
                 o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s");
-    std::printf("%-28s %10s %12s %12s %14s %10s\n", "mobile", "components", "steps/s", "us/step", "us/comp/step",
-                "halvings");
+    std::printf("%-27s %-46s | %s\n", "", "collisions off (issue 2)", "collisions on (issue 3)");
+    std::printf("%-20s %6s %11s %10s %8s %6s %6s | %10s %8s %6s %6s\n", "mobile", "comps", "steps/s", "us/step",
+                "us/comp", "halv", "solves", "us/step", "us/comp", "halv", "ratio");
     std::fflush(stdout);
     std::vector<std::string> notes;
     for (const char* preset : {"steel-fish.json", "southern-cross.json"}) {
@@ -170,7 +188,7 @@ Runner add_bench(CLI::App& app) {
       }
       try {
         const Model model = load_mobile(path.string());
-        print_row(preset, model.count, measure(model, o->steps));
+        print_row(preset, model.count, measure(model, o->steps, false), measure(model, o->steps, true));
       } catch (const std::exception& e) {
         notes.push_back(std::string(preset) + " skipped: " + e.what());
       }
@@ -180,7 +198,7 @@ Runner add_bench(CLI::App& app) {
       g.components = n;
       g.seed = 1;
       const Model model = compile(parse_mobile_text(generate_mobile(g), format("generated-%d.json", n)));
-      print_row(format("generated (seed 1)"), n, measure(model, o->steps));
+      print_row(format("generated (seed 1)"), n, measure(model, o->steps, false), measure(model, o->steps, true));
     }
     if (!notes.empty()) {
       std::printf("\n");

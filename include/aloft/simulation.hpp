@@ -94,11 +94,14 @@ class Simulation {
   long long step_count() const { return steps_; }
   // How many times a step had to be halved because the motion was too fast for it.
   long long subdivisions() const;
+  // How many Newton corrections (one tree solve each) the joint impulses needed, over all steps; a step
+  // costs this plus one solve for the velocity projection.
+  long long joint_iterations() const;
 
  private:
   bool rattle(double h);
   bool advance_by(double h, int depth);
-  void applied_wrenches(const State& state, std::vector<Eigen::Matrix<double, 6, 1>>& f) const;
+  Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
 
   const Model& model_;
   State state_;

@@ -51,9 +51,13 @@ struct StepWorkspace {
         drift_map(model.count, Mat3::Identity()),
         older_impulse(model.count, Vec3::Zero()),
         rotation(model.count, Mat3::Identity()),
+        child_arm(model.count, Vec3::Zero()),
+        parent_arm(model.count, Vec3::Zero()),
+        inverse_moments(model.count, Vec3::Zero()),
         response(model),
         pseudo(model.count, Vec6::Zero()) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
+    for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
   }
   TreeSolver solver;
   bool factored = false;         // solver holds the factorization at the current state's pose
@@ -69,7 +73,12 @@ struct StepWorkspace {
   double impulse_step = 0;       // the step length (s) the stored joint impulses belong to
   double older_step = 0;         // and the one of older_impulse
   std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
+  std::vector<Vec3> child_arm;   // at next's pose: R_i joint_in_child[i] (handed to the solver's factor)
+  std::vector<Vec3> parent_arm;  // at next's pose: R_p joint_in_parent[i]
+  std::vector<Vec3> inverse_moments;  // 1 / principal moments (kg^-1 m^-2)
+  double state_sum = 0;          // sum of the last accepted (sub)step's state entries (NaN check)
   long long subdivisions = 0;    // how many times a step was halved
+  long long joint_iterations = 0;  // SHAKE corrections (tree solves) over all (sub)steps
   // Collisions.
   std::unique_ptr<CollisionDetector> detector;  // null while collisions are off
   std::vector<Contact> contacts;  // found at the start of the last (sub)step
@@ -79,19 +88,31 @@ struct StepWorkspace {
 
 namespace {
 
-// Rotation by the rotation vector `theta` (rad, world) as a unit quaternion: exp(theta / 2).
-Quat rotation_quaternion(const Vec3& theta) {
+// exp(theta / 2) q, renormalised: the orientation q turned by the rotation vector `theta` (rad, world).
+// Written out in scalars (the quaternion product vectorises poorly at this size).
+inline Quat turned(const Vec3& theta, const Quat& q) {
   const double a2 = theta.squaredNorm();
+  double c, s;
   if (a2 < 1e-4) {
     // Taylor series of cos(a/2) and sin(a/2)/a to a^4; the first neglected terms are below
     // a^6/46080 < 3e-17 for a < 1e-2.
-    const double c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
-    const double s = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
-    return Quat(c, s * theta.x(), s * theta.y(), s * theta.z());
+    c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
+    s = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
+  } else {
+    const double a = std::sqrt(a2);
+    c = std::cos(0.5 * a);
+    s = std::sin(0.5 * a) / a;
   }
-  const double a = std::sqrt(a2);
-  const double s = std::sin(0.5 * a) / a;
-  return Quat(std::cos(0.5 * a), s * theta.x(), s * theta.y(), s * theta.z());
+  const double x = s * theta.x(), y = s * theta.y(), z = s * theta.z();
+  // (c, v) (w, u) = (c w - v.u, c u + w v + v x u)
+  const double rw = c * q.w() - (x * q.x() + y * q.y() + z * q.z());
+  const double rx = c * q.x() + q.w() * x + (y * q.z() - z * q.y());
+  const double ry = c * q.y() + q.w() * y + (z * q.x() - x * q.z());
+  const double rz = c * q.z() + q.w() * z + (x * q.y() - y * q.x());
+  // Both factors are unit to rounding, so |r|^2 = 1 + e with |e| ~ 1e-16: one Newton step for
+  // 1/sqrt(1 + e), (3 - |r|^2) / 2, renormalises to O(e^2) ~ 1e-32 without a square root or a division.
+  const double inverse_norm = 0.5 * (3.0 - (rw * rw + rx * rx + ry * ry + rz * rz));
+  return Quat(rw * inverse_norm, rx * inverse_norm, ry * inverse_norm, rz * inverse_norm);
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
@@ -132,26 +153,25 @@ State& Simulation::mutable_state() {
 
 long long Simulation::subdivisions() const { return work_->subdivisions; }
 
+long long Simulation::joint_iterations() const { return work_->joint_iterations; }
+
 void Simulation::set_timestep(double seconds) {
   timestep_ = seconds;
 }
 
 // Applied wrenches at `state` (world): gravity, external loads, air damping. There is no gyroscopic
 // term: the kicks change the world angular momentum L, whose rate is the torque alone; the rotation
-// of the inertia tensor is in the drift (step 3).
-void Simulation::applied_wrenches(const State& state, std::vector<Vec6>& f) const {
-  const std::vector<Mat3>& inertia = work_->solver.world_inertia();
-  for (int i = 1; i < model_.count; ++i) {
-    const double m = model_.mass[i];
-    f[i].head<3>() = m * model_.gravity + loads_.force[i];
-    f[i].tail<3>() = loads_.torque[i];
-  }
+// of the inertia tensor is in the drift (step 2). `momentum` is I w at `state` (for the damping).
+inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& momentum) const {
+  const double m = model_.mass[i];
+  Vec6 f;
+  f.head<3>() = m * model_.gravity + loads_.force[i];
+  f.tail<3>() = loads_.torque[i];
   if (damping_.linear != 0 || damping_.angular != 0) {
-    for (int i = 1; i < model_.count; ++i) {
-      f[i].head<3>() -= damping_.linear * model_.mass[i] * state.velocity[i];
-      f[i].tail<3>() -= damping_.angular * (inertia[i] * state.angular[i]);
-    }
+    f.head<3>() -= damping_.linear * m * state.velocity[i];
+    f.tail<3>() -= damping_.angular * momentum;
   }
+  return f;
 }
 
 // One RATTLE step of `h` seconds from state_ into work.next. Returns false, leaving state_ and the
@@ -166,27 +186,28 @@ bool Simulation::rattle(double h) {
   std::vector<Vec6>& f = work.wrench;
   std::vector<Vec3>& c = work.rows;
   std::vector<Vec6>& du = work.correction;
+  std::vector<Mat3>& rotation = work.rotation;
 
-  if (!work.factored) solver.factor(now);
+  if (!work.factored) {
+    solver.factor(now);
+    rotation[0] = now.orientation[0].toRotationMatrix();
+  }
   const std::vector<Vec3>& r = solver.child_arm();    // at the factored pose
   const std::vector<Vec3>& s = solver.parent_arm();
+  const std::vector<Mat3>& inertia = solver.world_inertia();
   const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
-  // 1. Applied wrenches at the current state.
-  applied_wrenches(now, f);
-
-  // 2. Half kick: applied impulses (h/2) f plus a guess of the joint impulses P (extrapolated from the
-  //    last two steps, or the last one scaled to this step's length), which act on the child as
-  //    (P, r x P) and on the parent as -(P, s x P).
+  // 1. Half kick: applied impulses (h/2) f at the current state plus a guess of the joint impulses P
+  //    (extrapolated from the last two steps, or the last one scaled to this step's length), which act
+  //    on the child as (P, r x P) and on the parent as -(P, s x P). Parents come first (parent[i] < i),
+  //    so f[p] is set before its children subtract from it.
+  const bool extrapolate = work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = work.impulse_step > 0 ? h / work.impulse_step : 0.0;
-  if (work.older_step == work.impulse_step && work.impulse_step == h) {
-    for (int i = 1; i < n; ++i) work.step_impulse[i] = 2.0 * work.impulse[i] - work.older_impulse[i];
-  } else {
-    for (int i = 1; i < n; ++i) work.step_impulse[i] = warm * work.impulse[i];
-  }
   for (int i = 1; i < n; ++i) {
-    const Vec3& impulse = work.step_impulse[i];
-    f[i] *= 0.5 * h;
+    const Vec3 impulse =
+        extrapolate ? Vec3(2.0 * work.impulse[i] - work.older_impulse[i]) : Vec3(warm * work.impulse[i]);
+    work.step_impulse[i] = impulse;
+    f[i] = (0.5 * h) * applied_wrench(now, i, inertia[i] * now.angular[i]);
     f[i].head<3>() += impulse;
     f[i].tail<3>() += r[i].cross(impulse);
     const int p = parent[i];
@@ -196,7 +217,7 @@ bool Simulation::rattle(double h) {
     }
   }
   for (int i = 1; i < n; ++i) {
-    next.velocity[i] = now.velocity[i] + f[i].head<3>() / model_.mass[i];
+    next.velocity[i] = now.velocity[i] + f[i].head<3>() * (1.0 / model_.mass[i]);
     next.angular[i] = now.angular[i] + inverse_inertia[i] * f[i].tail<3>();
   }
 
@@ -220,77 +241,88 @@ bool Simulation::rattle(double h) {
   for (int i = 1; i < n; ++i) fastest = std::max(fastest, next.angular[i].squaredNorm());
   if (!(h * std::sqrt(fastest) <= kMaxTurnPerStep)) return false;
   for (int i = 1; i < n; ++i) {
-    const Quat half = (rotation_quaternion(0.5 * h * next.angular[i]) * now.orientation[i]).normalized();
+    const Quat half = turned(0.5 * h * next.angular[i], now.orientation[i]);
     const Mat3 rot = half.toRotationMatrix();
-    work.drift_map[i] = rot * model_.principal_moments[i].cwiseInverse().asDiagonal() * rot.transpose() *
-                        solver.world_inertia()[i];
+    const Mat3 scaled = rot * work.inverse_moments[i].asDiagonal();
+    Mat3 midpoint_inverse_inertia;
+    midpoint_inverse_inertia.noalias() = scaled * rot.transpose();
+    work.drift_map[i].noalias() = midpoint_inverse_inertia * inertia[i];
   }
 
-  // 3. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
+  // 2. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
   //    of the half kick so that every joint closes at the new pose (SHAKE). Newton's method with the
   //    current pose's factorization: solving J du = -C(x')/h moves the joints by -C to first order.
+  //    One pass per iteration: the correction of the last solve (if any), the drift, the rotation
+  //    matrices and lever arms at the new pose (kept for the factorization), the joint gaps.
   double previous_worst = INFINITY;
   for (int iteration = 0;; ++iteration) {
     double worst = 0;
     for (int i = 1; i < n; ++i) {
-      next.position[i] = now.position[i] + h * next.velocity[i];
-      next.orientation[i] =
-          (rotation_quaternion(h * (work.drift_map[i] * next.angular[i])) * now.orientation[i]).normalized();
-    }
-    if (has_pseudo) {
-      for (int i = 1; i < n; ++i) {
-        next.position[i] += h * work.pseudo[i].head<3>();
-        next.orientation[i] = (rotation_quaternion(h * work.pseudo[i].tail<3>()) * next.orientation[i]).normalized();
+      if (iteration > 0) {
+        next.velocity[i] += du[i].head<3>();
+        next.angular[i] += du[i].tail<3>();
+        work.step_impulse[i] += c[i];
       }
-    }
-    for (int i = 1; i < n; ++i) work.rotation[i] = next.orientation[i].toRotationMatrix();
-    for (int i = 1; i < n; ++i) {
-      const int p = parent[i];
-      const Vec3 gap = (next.position[p] + work.rotation[p] * model_.joint_in_parent[i]) -
-                       (next.position[i] + work.rotation[i] * model_.joint_in_child[i]);
+      Vec3 position = now.position[i] + h * next.velocity[i];
+      Quat orientation = turned(h * (work.drift_map[i] * next.angular[i]), now.orientation[i]);
+      if (has_pseudo) {
+        position += h * work.pseudo[i].head<3>();
+        orientation = turned(h * work.pseudo[i].tail<3>(), orientation);
+      }
+      // The arms come from the local matrix, not from the array it is stored to (reading a just-written
+      // matrix back stalls on store forwarding).
+      const Mat3 turn = orientation.toRotationMatrix();
+      const Vec3 child_arm = turn * model_.joint_in_child[i];
+      const int p = parent[i];  // p < i: its rotation and position at the new pose are done
+      const Vec3 parent_arm = rotation[p] * model_.joint_in_parent[i];
+      const Vec3 gap = (next.position[p] + parent_arm) - (position + child_arm);
+      next.position[i] = position;
+      next.orientation[i] = orientation;
+      rotation[i] = turn;
+      work.child_arm[i] = child_arm;
+      work.parent_arm[i] = parent_arm;
       const double g = gap.cwiseAbs().maxCoeff();
       worst = g > worst || !std::isfinite(g) ? g : worst;  // a NaN gap stays NaN
-      c[i] = gap / h;
+      c[i] = gap * (1.0 / h);
     }
     if (worst <= kJointTolerance) break;
     // Not converging (too many iterations, growing or non-finite gaps): give up on this h.
     if (iteration == kMaxJointIterations || !std::isfinite(worst) || (iteration >= 2 && !(worst < 0.5 * previous_worst)))
       return false;
     previous_worst = worst;
-    for (int i = 1; i < n; ++i) f[i].setZero();
-    solver.solve(f, c, du, &work.rows);  // rows now hold this iteration's joint impulses
-    for (int i = 1; i < n; ++i) {
-      next.velocity[i] += du[i].head<3>();
-      next.angular[i] += du[i].tail<3>();
-      work.step_impulse[i] += c[i];
-    }
+    solver.solve_rows(c, du, &c);  // c now holds this iteration's joint impulses
+    ++work.joint_iterations;
   }
   std::swap(work.older_impulse, work.impulse);
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
 
-  // 4. Factor at the new pose (also used by the next step). Angular velocities follow the new
-  //    inertia at unchanged angular momentum: w' = I'^-1 I w.
-  for (int i = 1; i < n; ++i) next.angular[i] = solver.world_inertia()[i] * next.angular[i];
-  solver.factor(next);
-  for (int i = 1; i < n; ++i) next.angular[i] = inverse_inertia[i] * next.angular[i];
+  // 3. Factor at the new pose (also used by the next step), from the rotation matrices and lever arms of
+  //    the last drift pass. Angular velocities follow the new inertia at unchanged angular momentum:
+  //    w' = I'^-1 I w (next.angular holds L = I w across the factorization).
+  for (int i = 1; i < n; ++i) next.angular[i] = inertia[i] * next.angular[i];
+  solver.factor(rotation, work.child_arm, work.parent_arm);
 
-  // 5. Second half kick with the new pose's forces, and joint impulses that make the velocities tangent
+  // 4. Second half kick with the new pose's forces, and joint impulses that make the velocities tangent
   //    to the joints at the new pose (RATTLE): M du = (h/2) f' + J'^T mu,  J' (v + du) = 0.
-  applied_wrenches(next, f);
   for (int i = 1; i < n; ++i) {
-    const int p = parent[i];
+    const Vec3 momentum = next.angular[i];
+    next.angular[i] = inverse_inertia[i] * momentum;
+    f[i] = (0.5 * h) * applied_wrench(next, i, momentum);
+    const int p = parent[i];  // p < i: its angular velocity is already the new one
     const Vec3 child_point = next.velocity[i] + next.angular[i].cross(r[i]);
     const Vec3 parent_point = next.velocity[p] + next.angular[p].cross(s[i]);
     c[i] = parent_point - child_point;
-    f[i] *= 0.5 * h;
   }
   solver.solve(f, c, du);
+  double sum = 0;
   for (int i = 1; i < n; ++i) {
     next.velocity[i] += du[i].head<3>();
     next.angular[i] += du[i].tail<3>();
+    sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() + next.orientation[i].w();
   }
+  work.state_sum = sum;
   next.time = now.time + h;
   std::swap(state_, next);
   work.factored = true;
@@ -323,9 +355,12 @@ bool Simulation::step() {
 
   // Check: a non-finite state (or one the solver cannot close) stops the simulation with a report.
   const int n = model_.count;
-  double sum = 0;
-  for (int i = 1; i < n; ++i)
-    sum += state_.position[i].sum() + state_.velocity[i].sum() + state_.angular[i].sum() + state_.orientation[i].w();
+  double sum = work_->state_sum;  // of the state the last accepted (sub)step made
+  if (!converged) {
+    sum = 0;
+    for (int i = 1; i < n; ++i)
+      sum += state_.position[i].sum() + state_.velocity[i].sum() + state_.angular[i].sum() + state_.orientation[i].w();
+  }
   if (!converged || !std::isfinite(sum)) {
     int bad = 1;
     for (int i = 1; i < n; ++i)

@@ -6,12 +6,30 @@ namespace aloft {
 
 namespace {
 
-// World inertia R diag(I) R^T of a body with principal moments I and orientation q, and its inverse
-// R diag(1/I) R^T.
-void world_inertia_pair(const Quat& q, const Vec3& moments, Mat3& inertia, Mat3& inverse) {
-  const Mat3 r = q.toRotationMatrix();
-  inertia = r * moments.asDiagonal() * r.transpose();
-  inverse = r * moments.cwiseInverse().asDiagonal() * r.transpose();
+// m [s]x, column by column ([s]x e_j = s x e_j): 18 products instead of a full 3x3 product's 27.
+Mat3 times_skew(const Mat3& m, const Vec3& s) {
+  Mat3 out;
+  out.col(0) = s.z() * m.col(1) - s.y() * m.col(2);
+  out.col(1) = s.x() * m.col(2) - s.z() * m.col(0);
+  out.col(2) = s.y() * m.col(0) - s.x() * m.col(1);
+  return out;
+}
+
+// [s]x m, row by row.
+Mat3 skew_times(const Vec3& s, const Mat3& m) {
+  Mat3 out;
+  out.row(0) = s.y() * m.row(2) - s.z() * m.row(1);
+  out.row(1) = s.z() * m.row(0) - s.x() * m.row(2);
+  out.row(2) = s.x() * m.row(1) - s.y() * m.row(0);
+  return out;
+}
+
+// R diag(d) R^T (world inertia from principal moments d, or its inverse from 1/d).
+Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
+  Mat3 rd = r * d.asDiagonal();
+  Mat3 out;
+  out.noalias() = rd * r.transpose();
+  return out;
 }
 
 }  // namespace
@@ -19,14 +37,17 @@ void world_inertia_pair(const Quat& q, const Vec3& moments, Mat3& inertia, Mat3&
 TreeSolver::TreeSolver(const Model& model)
     : model_(model),
       n_(model.count),
+      leaf_(n_, 1),
+      inverse_mass_(n_, 0.0),
+      inverse_moments_(n_, Vec3::Zero()),
+      rotation_scratch_(n_, Mat3::Identity()),
       child_arm_(n_, Vec3::Zero()),
       parent_arm_(n_, Vec3::Zero()),
       inertia_(n_, Mat3::Zero()),
       inverse_inertia_(n_, Mat3::Zero()),
-      block_a_(n_, Mat3::Zero()),
-      block_b_(n_, Mat3::Zero()),
-      block_c_(n_, Mat3::Zero()),
-      has_children_(n_, 0),
+      sum_a_(n_, Mat3::Zero()),
+      sum_b_(n_, Mat3::Zero()),
+      sum_c_(n_, Mat3::Zero()),
       a_inv_(n_, Mat3::Zero()),
       t_(n_, Mat3::Zero()),
       s_inv_(n_, Mat3::Zero()),
@@ -34,77 +55,125 @@ TreeSolver::TreeSolver(const Model& model)
       k_inv_(n_, Mat3::Zero()),
       g_(n_, Vec6::Zero()),
       y_(n_, Vec6::Zero()),
-      a_(n_, Vec3::Zero()) {}
+      a_(n_, Vec3::Zero()) {
+  for (int i = 1; i < n_; ++i) {
+    if (model.parent[i] > 0) leaf_[model.parent[i]] = 0;
+    inverse_mass_[i] = 1.0 / model.mass[i];
+    inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
+  }
+}
 
 void TreeSolver::factor(const State& state) {
   const std::vector<int>& parent = model_.parent;
-
-  // Base to tip: world inertias, lever arms, and each body's own mass block M_i = diag(m E, I).
+  rotation_scratch_[0] = state.orientation[0].toRotationMatrix();
+  for (int i = 1; i < n_; ++i) rotation_scratch_[i] = state.orientation[i].toRotationMatrix();
   for (int i = 1; i < n_; ++i) {
-    const int p = parent[i];
-    world_inertia_pair(state.orientation[i], model_.principal_moments[i], inertia_[i], inverse_inertia_[i]);
-    child_arm_[i] = state.orientation[i] * model_.joint_in_child[i];
-    parent_arm_[i] = state.orientation[p] * model_.joint_in_parent[i];
-    block_a_[i] = model_.mass[i] * Mat3::Identity();
-    block_b_[i].setZero();
-    block_c_[i] = inertia_[i];
-    has_children_[i] = 0;
+    child_arm_[i] = rotation_scratch_[i] * model_.joint_in_child[i];
+    parent_arm_[i] = rotation_scratch_[parent[i]] * model_.joint_in_parent[i];
   }
+  factor_blocks(rotation_scratch_);
+}
 
-  // Tip to base: factor D_i, eliminate joint i, fold A^T K_i^-1 A (A = [E, -[s_i]x]) into the parent.
+void TreeSolver::factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
+                        std::vector<Vec3>& parent_arm) {
+  child_arm_.swap(child_arm);
+  parent_arm_.swap(parent_arm);
+  factor_blocks(rotation);
+}
+
+// One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
+// (children have larger indices, so they are done), then joint i eliminated into the parent:
+// A^T K_i^-1 A with A = [E, -[s_i]x] is [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
+void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
+  const std::vector<int>& parent = model_.parent;
   for (int i = n_ - 1; i >= 1; --i) {
-    const Mat3 rx = skew(child_arm_[i]);
+    inertia_[i] = rotate_diagonal(rotation[i], model_.principal_moments[i]);
+    inverse_inertia_[i] = rotate_diagonal(rotation[i], inverse_moments_[i]);
+    const Vec3& r = child_arm_[i];
     Mat3 k;
-    if (!has_children_[i]) {
-      // A leaf: D_i = M_i = diag(m E, I), so W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
-      a_inv_[i] = Mat3::Identity() / model_.mass[i];
-      t_[i].setZero();
-      s_inv_[i] = inverse_inertia_[i];
-      const Mat3 w_bottom = inverse_inertia_[i] * rx;
-      w_[i].topRows<3>() = a_inv_[i];
+    if (leaf_[i]) {
+      // D_i = M_i = diag(m E, I): W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
+      const Mat3 w_bottom = times_skew(inverse_inertia_[i], r);
+      w_[i].topRows<3>() = inverse_mass_[i] * Mat3::Identity();
       w_[i].bottomRows<3>() = w_bottom;
-      k = a_inv_[i] - rx * w_bottom;
+      k = -skew_times(r, w_bottom);
+      k.diagonal().array() += inverse_mass_[i];
     } else {
       // W_i = D^-1 [E; [r]x]: with Z = [r]x - T^T, W_bottom = S^-1 Z, W_top = A^-1 - T W_bottom, and
       // K_i = W_top - [r]x W_bottom = A^-1 + Z^T S^-1 Z.
-      a_inv_[i] = block_a_[i].inverse();
-      t_[i] = a_inv_[i] * block_b_[i];
-      s_inv_[i] = (block_c_[i] - block_b_[i].transpose() * t_[i]).inverse();
-      const Mat3 z = rx - t_[i].transpose();
-      const Mat3 w_bottom = s_inv_[i] * z;
-      w_[i].topRows<3>() = a_inv_[i] - t_[i] * w_bottom;
+      Mat3 a = sum_a_[i];
+      a.diagonal().array() += model_.mass[i];
+      const Mat3& b = sum_b_[i];
+      const Mat3 a_inv = a.inverse();
+      const Mat3 t = a_inv * b;
+      const Mat3 s_inv = (inertia_[i] + sum_c_[i] - b.transpose() * t).inverse();
+      Mat3 z = -t.transpose();
+      z(0, 1) -= r.z();
+      z(0, 2) += r.y();
+      z(1, 0) += r.z();
+      z(1, 2) -= r.x();
+      z(2, 0) -= r.y();
+      z(2, 1) += r.x();
+      const Mat3 w_bottom = s_inv * z;
+      w_[i].topRows<3>() = a_inv - t * w_bottom;
       w_[i].bottomRows<3>() = w_bottom;
-      k = a_inv_[i] + z.transpose() * w_bottom;
+      k = a_inv + z.transpose() * w_bottom;
+      a_inv_[i] = a_inv;
+      t_[i] = t;
+      s_inv_[i] = s_inv;
+      sum_a_[i].setZero();
+      sum_b_[i].setZero();
+      sum_c_[i].setZero();
     }
     const Mat3 k_inv = k.inverse();
     k_inv_[i] = k_inv;
     const int p = parent[i];
     if (p != 0) {
-      // A^T K^-1 A = [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
-      const Mat3 sx = skew(parent_arm_[i]);
-      const Mat3 k_sx = k_inv * sx;
-      block_a_[p] += k_inv;
-      block_b_[p] -= k_sx;
-      block_c_[p] -= sx * k_sx;
-      has_children_[p] = 1;
+      const Mat3 k_sx = times_skew(k_inv, parent_arm_[i]);
+      sum_a_[p] += k_inv;
+      sum_b_[p] -= k_sx;
+      sum_c_[p] -= skew_times(parent_arm_[i], k_sx);
     }
   }
 }
 
 void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
                        std::vector<Vec3>* lambda) {
-  const std::vector<int>& parent = model_.parent;
-  for (int i = 1; i < n_; ++i) g_[i] = f[i];
+  solve_sweeps<true>(&f, c, u, lambda);
+}
 
-  // Tip to base: y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i), and g_p += J_ip^T a_i.
+void TreeSolver::solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda) {
+  solve_sweeps<false>(nullptr, c, u, lambda);
+}
+
+template <bool kWithForces>
+void TreeSolver::solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
+                              std::vector<Vec3>* lambda) {
+  const std::vector<int>& parent = model_.parent;
+
+  // Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
+  // and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)
   for (int i = n_ - 1; i >= 1; --i) {
-    const Vec3 g1 = g_[i].head<3>();
-    const Vec3 y2 = s_inv_[i] * (g_[i].tail<3>() - t_[i].transpose() * g1);
-    y_[i].head<3>() = a_inv_[i] * g1 - t_[i] * y2;
-    y_[i].tail<3>() = y2;
-    const Vec3 r = child_arm_[i];
-    const Vec3 j_y = y_[i].head<3>() + y_[i].tail<3>().cross(r);  // v + w x r
-    a_[i] = k_inv_[i] * (c[i] - j_y);
+    const Vec3& r = child_arm_[i];
+    Vec3 rhs = c[i];
+    if (leaf_[i] && !kWithForces) {
+      y_[i].setZero();  // a leaf with no applied wrench: g = 0
+    } else {
+      Vec6 g = g_[i];
+      g_[i].setZero();
+      if constexpr (kWithForces) g += (*f)[i];
+      const Vec3 g1 = g.head<3>();
+      if (leaf_[i]) {
+        y_[i].head<3>() = inverse_mass_[i] * g1;
+        y_[i].tail<3>() = inverse_inertia_[i] * g.tail<3>();
+      } else {
+        const Vec3 y2 = s_inv_[i] * (g.tail<3>() - t_[i].transpose() * g1);
+        y_[i].head<3>() = a_inv_[i] * g1 - t_[i] * y2;
+        y_[i].tail<3>() = y2;
+      }
+      rhs -= y_[i].head<3>() + y_[i].tail<3>().cross(r);  // c - (v + w x r)
+    }
+    a_[i] = k_inv_[i] * rhs;
     const int p = parent[i];
     if (p != 0) {
       g_[p].head<3>() -= a_[i];
@@ -133,9 +202,7 @@ Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state) {
   for (int i = 1; i < model.count; ++i) {
     const int b = 6 * (i - 1);
     h.block<3, 3>(b, b) = model.mass[i] * Mat3::Identity();
-    Mat3 inertia, inverse;
-    world_inertia_pair(state.orientation[i], model.principal_moments[i], inertia, inverse);
-    h.block<3, 3>(b + 3, b + 3) = inertia;
+    h.block<3, 3>(b + 3, b + 3) = rotate_diagonal(state.orientation[i].toRotationMatrix(), model.principal_moments[i]);
   }
   for (int k = 1; k < model.count; ++k) {
     const int row = 6 * m + 3 * (k - 1);

@@ -14,9 +14,10 @@
 // body, the articulated block
 //     D_k = M_k + sum over child joints c of J_ck^T K_c^-1 J_ck,      K_k = J_kk D_k^-1 J_kk^T,
 // which are exactly Baraff's D (body node) and -D (joint node) blocks; L_kp = D_k^-1 J_kp is applied
-// implicitly. factor() computes them tip to base; solve() does one tip-to-base and one base-to-tip sweep.
-// Every block is 6x6, 6x3 or 3x3, so both cost O(n). The arrays are sized once; nothing allocates
-// after construction.
+// implicitly. factor() computes them in one tip-to-base sweep; solve() does one tip-to-base and one
+// base-to-tip sweep. Every block is 6x6, 6x3 or 3x3, so both cost O(n). A leaf (a body with no child
+// joint) has D = M, whose inverse needs no work: its blocks are formed and used in that short form.
+// The arrays are sized once; nothing allocates after construction.
 
 #include <vector>
 
@@ -36,10 +37,19 @@ class TreeSolver {
   // Form and factor H at the pose `state` (orientations give the world inertias and lever arms).
   void factor(const State& state);
 
+  // The same at a pose given by every body's world rotation matrix (rotation[i] = R(q_i), body -> world;
+  // index 0 unused) and the world lever arms r_k = R_k joint_in_child[k], s_k = R_p joint_in_parent[k],
+  // as the caller already has them (the step computes them for its joint gaps). The arm arrays are taken
+  // over by swapping: the caller gets the previous pose's arrays back, as scratch of the same size.
+  void factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm, std::vector<Vec3>& parent_arm);
+
   // Solve with the last factorization. f: per body (force N, torque N m), world; c: per joint (3);
   // entries for index 0 are ignored. Writes u (per body; u[0] = 0) and, if given, lambda (per joint).
+  // `lambda` may be the same array as `c`.
   void solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
              std::vector<Vec3>* lambda = nullptr);
+  // The same with f = 0 (joint rows only), which saves the leaves' work.
+  void solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda = nullptr);
 
   // World lever arms at the factored pose: centre of mass of body i -> joint i, and of parent -> joint i.
   const std::vector<Vec3>& child_arm() const { return child_arm_; }
@@ -49,26 +59,36 @@ class TreeSolver {
   const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
 
  private:
+  void factor_blocks(const std::vector<Mat3>& rotation);
+  template <bool kWithForces>
+  void solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
+                    std::vector<Vec3>* lambda);
+
   const Model& model_;
   int n_;
+  std::vector<char> leaf_;          // body i has no child joint (fixed by the topology)
+  std::vector<double> inverse_mass_;      // 1 / m_i
+  std::vector<Vec3> inverse_moments_;     // 1 / principal moments
+  std::vector<Mat3> rotation_scratch_;    // factor(State): rotation matrices of the orientations
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
   std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
-  // D_i = [A B; B^T C] is accumulated in 3x3 blocks, tip to base, then inverted through the Schur
-  // complement of A (all 3x3 work).
-  std::vector<Mat3> block_a_;       // m E + sum K_c^-1                    (symmetric)
-  std::vector<Mat3> block_b_;       // - sum K_c^-1 [s_c]x
-  std::vector<Mat3> block_c_;       // I + sum -[s_c]x K_c^-1 [s_c]x       (symmetric)
-  std::vector<char> has_children_;  // whether any joint was folded into the blocks
+  // D_i = [m E + A'; B; B^T I_i + C'] is accumulated from the children's joints in 3x3 blocks during the
+  // tip-to-base sweep (A', B, C' below, reset to zero once used), then inverted through the Schur
+  // complement of A = m E + A' (all 3x3 work).
+  std::vector<Mat3> sum_a_;         // sum K_c^-1                          (symmetric)
+  std::vector<Mat3> sum_b_;         // - sum K_c^-1 [s_c]x
+  std::vector<Mat3> sum_c_;         // sum -[s_c]x K_c^-1 [s_c]x           (symmetric)
   // D_i^-1 in factored form: with T = A^-1 B and S = C - B^T T,
   //   D^-1 [g1; g2] = [A^-1 g1 - T y2; y2],  y2 = S^-1 (g2 - T^T g1).
-  std::vector<Mat3> a_inv_;         // A^-1 (symmetric)
-  std::vector<Mat3> t_;             // T = A^-1 B (zero for a leaf)
-  std::vector<Mat3> s_inv_;         // S^-1 (symmetric)
+  // A leaf has A^-1 = E/m, T = 0, S^-1 = I^-1 and uses inverse_mass_ and inverse_inertia_ instead.
+  std::vector<Mat3> a_inv_;         // A^-1 (symmetric; interior bodies only)
+  std::vector<Mat3> t_;             // T = A^-1 B (interior bodies only)
+  std::vector<Mat3> s_inv_;         // S^-1 (symmetric; interior bodies only)
   std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
   std::vector<Mat3> k_inv_;         // K_i^-1
-  std::vector<Vec6> g_;             // solve scratch: condensed right-hand sides
+  std::vector<Vec6> g_;             // solve scratch: what the children's joints add to f (zero between solves)
   std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
   std::vector<Vec3> a_;             // solve scratch: joint terms
 };
