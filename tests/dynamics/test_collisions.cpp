@@ -1,0 +1,199 @@
+// Collisions inside the simulation: no tunnelling through a thin plate, resting contact without jitter or
+// sinking, energy that never grows, and the Steel Fish shaken hard.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "aloft/collision.hpp"
+#include "aloft/model.hpp"
+#include "aloft/simulation.hpp"
+#include "aloft/spec.hpp"
+#include "support/presets.hpp"
+
+namespace aloft {
+namespace {
+
+Model model_from(const std::string& json) { return compile(parse_mobile_text(json)); }
+
+// A 20 mm steel ball on a 0.5 m thread from the hook, and beside it a 2 mm steel pane hanging on its
+// own thread, its near face 29 mm to the right of the ball. (A pane on the hook itself would not do:
+// a component and its parent never collide, as in the paper.) Damping off: energy can only leave
+// through the collision.
+const char* const kBallAndPane = R"({
+  "name": "ball and pane", "contact": {"restitution": 0.5, "friction": 0.3},
+  "components": [
+    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.01, 1, 0], "to": [0.06, 1, 0], "radius": 0.003}}]},
+    {"name": "ball", "parent": "hook", "joint": [0, 1, 0], "shapes": [
+      {"wire": {"from": [0, 1, 0], "to": [0, 0.52, 0], "radius": 0.001}},
+      {"sphere": {"center": [0, 0.5, 0], "radius": 0.02}}]},
+    {"name": "pane", "parent": "hook", "joint": [0.05, 1, 0], "shapes": [
+      {"wire": {"from": [0.05, 1, 0], "to": [0.05, 0.6, 0], "radius": 0.0005}},
+      {"plate": {"plane": {"origin": [0.05, 0.5, 0], "u": [0, 0, 1], "v": [0, 1, 0]}, "thickness": 0.002,
+                 "points": [[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]}}]}]})";
+
+// Swing the ball at the pane: angular velocity about z giving the ball's centre `speed` m/s along +x.
+Simulation& swing(Simulation& sim, double speed) {
+  State& s = sim.mutable_state();
+  const Vec3 pivot(0, 1, 0);
+  const double omega = speed / 0.5;
+  s.angular[1] = Vec3(0, 0, omega);
+  s.velocity[1] = s.angular[1].cross(s.position[1] - pivot);
+  return sim;
+}
+
+// How far (m) the ball reaches into the pane: ball radius + half the pane's thickness minus the distance
+// of the ball's centre from the pane's mid-plane, measured on the side the ball starts on. Negative while
+// apart; 0.042 m once the ball is wholly through.
+double overlap_with_pane(const Model& model, const State& s) {
+  const Plate& pane = std::get<Plate>(model.shapes[2][1].shape);
+  const Sphere& ball = std::get<Sphere>(model.shapes[1][1].shape);
+  const Vec3 normal = s.orientation[2] * pane.normal();  // -x at rest: towards the ball
+  const Vec3 mid_plane_point = s.position[2] + s.orientation[2] * pane.origin;
+  const Vec3 centre = s.position[1] + s.orientation[1] * ball.center;
+  return ball.radius + 0.5 * pane.thickness - normal.dot(centre - mid_plane_point);
+}
+
+TEST(Collisions, FastBallDoesNotTunnelThroughAThinPlate) {
+  const Model model = model_from(kBallAndPane);
+  Simulation sim(model);
+  swing(sim, 5.0);
+  double furthest = -1, energy_before = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+  double energy_max = energy_before;
+  bool knocked = false;
+  for (int step = 0; step < 300; ++step) {  // 0.3 s: the ball reaches the pane after ~6 ms
+    ASSERT_TRUE(sim.step()) << sim.failure()->message;
+    // The knock happens in the first 10 ms; afterwards the pane swings and turns away and the distance
+    // to its (unbounded) mid-plane no longer measures an overlap.
+    if (step < 50) furthest = std::max(furthest, overlap_with_pane(model, sim.state()));
+    energy_max = std::max(energy_max, kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()));
+    knocked = knocked || sim.state().velocity[2].x() > 1.0;  // the pane was sent flying
+  }
+  EXPECT_TRUE(knocked);
+  // At 5 m/s a 1 ms step moves the ball 5 mm, more than the pane is thick. The speculative contact stops
+  // it before it touches (it may bounce up to one step's travel early), and overlap is bounded by the
+  // contact's penetration slop (0.05 mm) plus the second-order drift of one step (g h^2 ~ 0.01 mm).
+  EXPECT_LT(furthest, 1e-4) << "the ball went " << furthest * 1e3 << " mm into the pane";
+  // And over the whole run, as the detector measures it (ball, threads and pane all included).
+  EXPECT_LT(sim.collision_statistics().deepest, 1e-4);
+  // The collision (e = 0.5) only removes energy; the integrator's own error is ~1e-6 of the energy.
+  EXPECT_LT(energy_max - energy_before, 1e-5 * std::abs(energy_before) + 1e-6);
+  EXPECT_GT(sim.collision_statistics().impulses, 0);
+}
+
+TEST(Collisions, WithCollisionsOffTheBallPassesThrough) {
+  // The same swing with collisions off: the test above can fail.
+  const Model model = model_from(kBallAndPane);
+  Simulation sim(model);
+  sim.set_collisions(false);
+  swing(sim, 5.0);
+  double furthest = -1;
+  for (int step = 0; step < 100; ++step) {
+    ASSERT_TRUE(sim.step());
+    furthest = std::max(furthest, overlap_with_pane(model, sim.state()));
+  }
+  EXPECT_GT(furthest, 0.042);  // wholly through
+}
+
+// Two 30 mm steel balls on 0.5 m threads from points 40 mm apart, drawn swung 10 degrees apart. Released,
+// they swing together, knock (e = 0.3), and settle leaning on each other 1.15 degrees off the vertical,
+// each pushed against the other by gravity. (They must hang from separate points of the hook: a
+// component and its parent never collide.)
+const char* const kLeaningBalls = R"({
+  "name": "leaning balls", "contact": {"restitution": 0.3, "friction": 0.5},
+  "damping": {"linear": 0.5, "angular": 0.5},
+  "components": [
+    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.03, 1, 0], "to": [0.03, 1, 0], "radius": 0.003}}]},
+    {"name": "left", "parent": "hook", "joint": [-0.02, 1, 0], "shapes": [
+      {"wire": {"from": [-0.02, 1, 0], "to": [-0.10682408883346517, 0.5075961234938124, 0], "radius": 0.0005}},
+      {"sphere": {"center": [-0.10682408883346517, 0.5075961234938124, 0], "radius": 0.03}}]},
+    {"name": "right", "parent": "hook", "joint": [0.02, 1, 0], "shapes": [
+      {"wire": {"from": [0.02, 1, 0], "to": [0.10682408883346517, 0.5075961234938124, 0], "radius": 0.0005}},
+      {"sphere": {"center": [0.10682408883346517, 0.5075961234938124, 0], "radius": 0.03}}]}]})";
+
+TEST(Collisions, RestingContactNeitherJittersNorSinks) {
+  const Model model = model_from(kLeaningBalls);
+  Simulation sim(model);
+  auto centre = [&](const State& s, int i) {
+    return Vec3(s.position[i] + s.orientation[i] * std::get<Sphere>(model.shapes[i][1].shape).center);
+  };
+  ASSERT_TRUE(sim.advance(6.0));  // the knock and the bounces die out (damping 0.5/s, e = 0.3)
+  double deepest = 0, moved = 0, lowest_gap = 1, highest_gap = -1;
+  const Vec3 left = centre(sim.state(), 1), right = centre(sim.state(), 2);
+  for (int step = 0; step < 1000; ++step) {
+    ASSERT_TRUE(sim.step());
+    const State& s = sim.state();
+    const double gap = (centre(s, 1) - centre(s, 2)).norm() - 0.06;
+    lowest_gap = std::min(lowest_gap, gap);
+    highest_gap = std::max(highest_gap, gap);
+    deepest = std::max(deepest, -gap);
+    moved = std::max({moved, (centre(s, 1) - left).norm(), (centre(s, 2) - right).norm()});
+  }
+  std::printf("leaning balls: gap from %.3g to %.3g mm, moved at most %.3g mm in 1 s\n", lowest_gap * 1e3,
+              highest_gap * 1e3, moved * 1e3);
+  // Leaning, not hovering apart: in contact within the 0.05 mm penetration slop ...
+  EXPECT_LT(highest_gap, 5e-5);
+  // ... not sinking: the overlap stays at the slop's scale (0.05 mm, plus one step of gravity) ...
+  EXPECT_LT(deepest, 1e-4);
+  // ... and not jittering or creeping: over a whole second neither ball moves by 1 micrometre, a
+  // thousandth of anything visible. (The velocities at step boundaries carry half a step of gravity,
+  // g sin(1.15 deg) h / 2 = 0.1 mm/s, that the next step's contact impulse removes before anything moves.)
+  EXPECT_LT(moved, 1e-6);
+  EXPECT_LT(highest_gap - lowest_gap, 1e-5);
+}
+
+TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) {
+  const Model model = test::load_preset("steel-fish", BalanceMode::Mass);  // no air damping
+  Simulation sim(model);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  const double weight = 9.81 * model.balance.total_mass;
+  double worst_gain = 0, worst_left_overlap = 0;
+  // 10 minutes of simulated time in cycles of 2 s: shaken hard for 1 s, as if the hook were jerked about
+  // (a uniform random acceleration of 0.5 g rms per axis, a new one every 50 ms: the arms swing
+  // through half a turn and knock into each other), then left alone for 1 s. One minute under the
+  // sanitizers (ten times slower).
+#ifdef ALOFT_SANITIZED
+  const int cycles = 30;
+#else
+  const int cycles = 300;
+#endif
+  CollisionDetector detector(model);
+  std::vector<Contact> contacts;
+  for (int cycle = 0; cycle < cycles; ++cycle) {
+    for (int burst = 0; burst < 20; ++burst) {
+      const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));
+      for (int i = 1; i < model.count; ++i) sim.loads().force[i] = model.mass[i] * jerk;
+      ASSERT_TRUE(sim.advance(0.05)) << sim.failure()->message;
+    }
+    sim.loads().clear();
+    const double kinetic = kinetic_energy(model, sim.state());
+    const double start = kinetic + potential_energy(model, sim.state());
+    ASSERT_TRUE(sim.advance(1.0)) << sim.failure()->message;
+    const double end = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+    // Allowed: the integrator's error (1e-4 of the kinetic energy; the conservation test measures far
+    // less without contacts) and the lift of the overlap correction, which may raise a piece by its
+    // overlap (< 0.1 mm) against gravity.
+    const double allowed = 1e-4 * kinetic + weight * 1e-4;
+    worst_gain = std::max(worst_gain, (end - start) / allowed);
+    // Joints together (the core's bound, 1e-6 m).
+    ASSERT_LT(max_joint_separation(model, sim.state()), 1e-6) << "cycle " << cycle;
+    // Nothing stays inside anything: after a second left alone, every pair is apart or resting on
+    // another within the contact's penetration slop (0.05 mm; 0.1 mm allowed).
+    detector.find_contacts(sim.state(), 0.0, 1e-3, contacts);
+    for (const Contact& c : contacts) worst_left_overlap = std::max(worst_left_overlap, -c.distance);
+  }
+  const CollisionStatistics& stats = sim.collision_statistics();
+  EXPECT_GT(stats.impulses, 100) << "the shaking should make the pieces knock";
+  EXPECT_LT(worst_left_overlap, 1e-4);
+  // Left alone, the energy never grows by more than allowed above.
+  EXPECT_LT(worst_gain, 1.0);
+  std::printf("steel fish shaken %d s: %lld contact impulses (%lld sliding), deepest transient overlap %.3g mm, "
+              "deepest after a second left alone %.3g mm, energy removed %.3g J, worst gain when left alone "
+              "%.3g of the allowance\n",
+              2 * cycles, stats.impulses, stats.sliding, stats.deepest * 1e3, worst_left_overlap * 1e3,
+              stats.energy_removed, worst_gain);
+}
+
+}  // namespace
+}  // namespace aloft
