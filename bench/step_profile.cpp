@@ -1,0 +1,84 @@
+// aloft_step_profile: a fixed, repeatable stepping run for profilers (valgrind --tool=callgrind counts
+// instructions deterministically, so two builds can be compared on a busy machine) and a quick CPU-time
+// figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), then
+// `steps` steps are taken inside timed_steps(), the function to give callgrind's --toggle-collect.
+//
+//   aloft_step_profile MOBILE STEPS [collisions 0|1]
+//     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
+//
+// Prints the thread CPU time per step and per moving component-step, the step halvings and tree solves
+// per step, and a checksum of the final state (equal on two runs of one build).
+
+#include <time.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+
+#include "aloft/generate.hpp"
+#include "aloft/model.hpp"
+#include "aloft/simulation.hpp"
+
+namespace {
+
+double thread_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+__attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
+  for (long k = 0; k < steps; ++k)
+    if (!sim.step()) return false;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace aloft;
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: aloft_step_profile MOBILE(.json or component count) STEPS [collisions 0|1]\n");
+    return 2;
+  }
+  const std::string what = argv[1];
+  const long steps = std::atol(argv[2]);
+  const bool collisions = argc > 3 && std::atoi(argv[3]) != 0;
+  try {
+    Model model;
+    if (what.size() > 5 && what.substr(what.size() - 5) == ".json") {
+      model = load_mobile(what);
+    } else {
+      GenerateOptions g;
+      g.components = std::atoi(what.c_str());
+      g.seed = 1;
+      model = compile(parse_mobile_text(generate_mobile(g), "generated-" + what + ".json"));
+    }
+    Simulation sim(model);
+    sim.set_collisions(collisions);
+    for (int i = 1; i < model.count; ++i) {
+      const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
+      sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+    }
+    for (int k = 0; k < 300; ++k)
+      if (!sim.step()) throw std::runtime_error(sim.failure()->message);
+    sim.loads().clear();
+    const long long halvings = sim.subdivisions(), iterations = sim.joint_iterations();
+    const double start = thread_seconds();
+    if (!timed_steps(sim, steps)) throw std::runtime_error(sim.failure()->message);
+    const double seconds = thread_seconds() - start;
+    const double subdivided = static_cast<double>(sim.subdivisions() - halvings);
+    double checksum = 0;
+    for (int i = 1; i < model.count; ++i)
+      checksum += sim.state().position[i].sum() + sim.state().orientation[i].coeffs().sum() + sim.state().angular[i].sum();
+    std::printf("%s: %.3f us/step, %.4f us per component-step, %.3f halvings and %.2f solves per step; checksum %.17g\n",
+                what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
+                (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "aloft_step_profile: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
