@@ -119,7 +119,9 @@ inline Quat turned(const Vec3& theta, const Quat& q) {
   const double rz = c * q.z() + q.w() * z + (x * q.y() - y * q.x());
   // Both factors are unit to rounding, so |r|^2 = 1 + e with |e| ~ 1e-16: one Newton step for
   // 1/sqrt(1 + e), (3 - |r|^2) / 2, renormalises to O(e^2) ~ 1e-32 without a square root or a division.
-  const double inverse_norm = 0.5 * (3.0 - (rw * rw + rx * rx + ry * ry + rz * rz));
+  // (An orientation set from outside that is not unit, |e| >= 1e-8, is normalised exactly.)
+  const double norm2 = rw * rw + rx * rx + ry * ry + rz * rz;
+  const double inverse_norm = std::abs(norm2 - 1.0) < 1e-8 ? 0.5 * (3.0 - norm2) : 1.0 / std::sqrt(norm2);
   return Quat(rw * inverse_norm, rx * inverse_norm, ry * inverse_norm, rz * inverse_norm);
 }
 
