@@ -48,6 +48,7 @@ struct StepWorkspace {
   explicit StepWorkspace(const Model& model)
       : solver(model),
         next(rest_state(model)),
+        backup(rest_state(model)),
         wrench(model.count, Vec6::Zero()),
         rows(model.count, Vec3::Zero()),
         correction(model.count, Vec6::Zero()),
@@ -68,7 +69,8 @@ struct StepWorkspace {
   TreeSolver solver;
   bool factored = false;         // solver holds the factorization at the current state's pose
   State next;                    // the state being computed; swapped in when the step succeeds
-  State backup;                  // the state before a subdivided step, to return to if it fails
+  State backup;                  // the state before a subdivided step, to return to if it fails (sized
+                                 // here, so that the first halving does not allocate either)
   std::vector<Vec6> wrench;      // scratch per body (force, torque), world
   std::vector<Vec3> rows;        // scratch per joint
   std::vector<Vec6> correction;  // solver output per body
