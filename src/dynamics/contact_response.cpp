@@ -147,7 +147,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   for (int k = 0; k < m; ++k) {
     const double overlap = -contacts[k].distance - tuning.penetration_slop;
     if (overlap > 0) {
-      target[k] = tuning.penetration_rate * overlap / h;
+      target[k] = std::min(tuning.penetration_rate * overlap, tuning.max_push) / h;
       penetrating = true;
     }
   }

@@ -35,6 +35,10 @@ struct ContactTuning {
   double bounce_threshold = 0.005;
   double penetration_slop = 5e-5;  // m: overlap tolerated without correction (round-off, settling)
   double penetration_rate = 0.8;   // fraction of the overlap beyond the slop removed per step
+  // m: the most a step's overlap correction may move a contact apart. The pseudo-velocity respects
+  // the joints only to first order; SHAKE closes the second-order rest with real impulses, which
+  // could add energy if a deep overlap were pushed out in one step.
+  double max_push = 1e-3;
 };
 
 // What the last resolve did (for statistics, the viewer and tests).
