@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "aloft/model.hpp"
 
@@ -50,15 +51,44 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
 }
 
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
-                                           const std::vector<Contact>& contacts, double h,
+                                           const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
                                            std::vector<Vec6>& pseudo, bool& has_pseudo) {
   ContactStepReport report;
   has_pseudo = false;
-  const int m = static_cast<int>(contacts.size());
-  report.contacts = m;
-  if (m == 0) return report;
+  report.contacts = static_cast<int>(found.size());
   solver_ = &solver;
+
+  // Keep the contacts that matter this step: touching or overlapping, or closing their gap within two
+  // steps at their present approach speed. The detector's margin is a bound over every direction of
+  // motion; most of what it reports cannot close, and each kept contact costs three tree solves.
+  // At most kMaxContacts, the soonest to close first (the rest are looked at again next step).
+  std::vector<Contact>& contacts = kept_;
+  contacts.clear();
+  closing_.clear();
+  for (const Contact& c : found) {
+    auto point_velocity = [&](int body, const Vec3& point) -> Vec3 {
+      return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(point - pose.position[body]));
+    };
+    const double un = c.normal.dot(point_velocity(c.a, c.point) - point_velocity(c.b, c.point));
+    const double gap_after_two_steps = c.distance + 2.0 * h * std::min(un, 0.0);
+    if (c.distance > tuning.penetration_slop && gap_after_two_steps > tuning.penetration_slop) continue;
+    closing_.push_back({gap_after_two_steps, static_cast<int>(closing_.size())});
+    contacts.push_back(c);
+  }
+  if (static_cast<int>(contacts.size()) > kMaxContacts) {
+    std::vector<std::pair<double, int>> order = closing_;
+    std::stable_sort(order.begin(), order.end());
+    std::vector<Contact> soonest;
+    for (int k = 0; k < kMaxContacts; ++k) soonest.push_back(contacts[order[k].second]);
+    std::sort(soonest.begin(), soonest.end(), [](const Contact& x, const Contact& y) {
+      return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
+    report.dropped = static_cast<int>(contacts.size()) - kMaxContacts;
+    contacts = std::move(soonest);
+  }
+  const int m = static_cast<int>(contacts.size());
+  if (m == 0) return report;
 
   // Contact frames, lever arms and the velocities before the impulse (a relative to b, contact basis).
   basis_.resize(m);
@@ -165,8 +195,9 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   return report;
 }
 
-bool ContactResponse::correct(const std::vector<Contact>& contacts, double h, std::vector<Vec3>& velocity,
-                              std::vector<Vec3>& angular, double tolerance) {
+bool ContactResponse::correct(double h, std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
+                              double tolerance) {
+  const std::vector<Contact>& contacts = kept_;
   const int m = static_cast<int>(contacts.size());
   if (m == 0) return false;
   bool needed = false;

@@ -21,6 +21,7 @@
 // If the Newton restitution targets would add kinetic energy (possible with sticking friction and
 // several contacts), the step's impulses are recomputed with e = 0, which only removes energy.
 
+#include <utility>
 #include <vector>
 
 #include "aloft/collision.hpp"
@@ -43,7 +44,8 @@ struct ContactTuning {
 
 // What the last resolve did (for statistics, the viewer and tests).
 struct ContactStepReport {
-  int contacts = 0;            // speculative contacts considered
+  int contacts = 0;            // speculative contacts reported by the detector
+  int dropped = 0;             // closing contacts beyond kMaxContacts, left to the next step
   int active = 0;              // contacts that received an impulse
   int sticking = 0;
   int sliding = 0;
@@ -66,12 +68,16 @@ class ContactResponse {
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
                             bool& has_pseudo);
 
-  // After the joints' impulses changed the velocities (SHAKE), make the contacts of the last resolve()
-  // hold again: the same collision matrix, targets without restitution (the bounce was given), the
-  // extra impulses applied to `velocity`/`angular`. Returns whether any impulse was needed beyond
-  // `tolerance` (m/s of normal velocity).
-  bool correct(const std::vector<Contact>& contacts, double h, std::vector<Vec3>& velocity,
-               std::vector<Vec3>& angular, double tolerance);
+  // After the joints' impulses changed the velocities (SHAKE), make the contacts kept by the last
+  // resolve() hold again: the same collision matrix, targets without restitution (the bounce was
+  // given), the extra impulses applied to `velocity`/`angular`. Returns whether any impulse was needed
+  // beyond `tolerance` (m/s of normal velocity).
+  bool correct(double h, std::vector<Vec3>& velocity, std::vector<Vec3>& angular, double tolerance);
+
+  // The most contacts solved in one step (the collision matrix is 3m x 3m and costs 3m tree solves).
+  static constexpr int kMaxContacts = 128;
+  // The contacts the last resolve() solved, in the order of the matrices below.
+  const std::vector<Contact>& kept() const { return kept_; }
 
   ContactTuning tuning;
 
@@ -91,6 +97,8 @@ class ContactResponse {
 
   const Model& model_;
   TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose
+  std::vector<Contact> kept_;     // the contacts solved: touching, overlapping or closing
+  std::vector<std::pair<double, int>> closing_;  // their gap after two steps (m) and index
   std::vector<Mat3> basis_;
   std::vector<Vec3> arm_a_, arm_b_;  // centre of mass of a (b) -> contact point, world, m
   std::vector<ContactLawRow> rows_;

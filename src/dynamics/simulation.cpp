@@ -334,7 +334,7 @@ bool Simulation::rattle(double h) {
       // The joint impulses changed the velocities after the contacts were solved: if a contact is
       // approaching again, correct it (no new bounce) and close the joints once more.
       if (contact_report.active == 0 || contact_passes == kMaxContactPasses ||
-          !work.response.correct(work.contacts, h, next.velocity, next.angular, kContactVelocityTolerance))
+          !work.response.correct(h, next.velocity, next.angular, kContactVelocityTolerance))
         break;
       ++contact_passes;
       previous_worst = INFINITY;
