@@ -238,6 +238,11 @@ bool Simulation::rattle(double h) {
   bool has_pseudo = false;
   ContactStepReport contact_report;
   if (collisions_) {
+    // A step that will be halved for turning too fast (checked again below, after the impulses) is
+    // not worth a detection whose margins its speeds would make huge.
+    double spin = 0;
+    for (int i = 1; i < n; ++i) spin = std::max(spin, next.angular[i].squaredNorm());
+    if (!(h * std::sqrt(spin) <= kMaxTurnPerStep)) return false;
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
