@@ -21,6 +21,17 @@ Mat3 contact_basis(const Vec3& n) {
   return basis;
 }
 
+// Velocity (m/s, world) of the point at `arm` from body's centre of mass; the fixed component 0 is still.
+Vec3 point_velocity(int body, const Vec3& arm, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) {
+  return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
+}
+
+// Relative velocity of contact c's point on a with respect to b, world.
+Vec3 relative_velocity(const Contact& c, const Vec3& arm_a, const Vec3& arm_b, const std::vector<Vec3>& velocity,
+                       const std::vector<Vec3>& angular) {
+  return point_velocity(c.a, arm_a, velocity, angular) - point_velocity(c.b, arm_b, velocity, angular);
+}
+
 }  // namespace
 
 ContactResponse::ContactResponse(const Model& model)
@@ -67,10 +78,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   contacts.clear();
   closing_.clear();
   for (const Contact& c : found) {
-    auto point_velocity = [&](int body, const Vec3& point) -> Vec3 {
-      return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(point - pose.position[body]));
-    };
-    const double un = c.normal.dot(point_velocity(c.a, c.point) - point_velocity(c.b, c.point));
+    const double un = c.normal.dot(relative_velocity(c, c.point - pose.position[c.a], c.point - pose.position[c.b],
+                                                     velocity, angular));
     const double gap_after_two_steps = c.distance + 2.0 * h * std::min(un, 0.0);
     if (c.distance > tuning.penetration_slop && gap_after_two_steps > tuning.penetration_slop) continue;
     closing_.push_back({gap_after_two_steps, static_cast<int>(closing_.size())});
@@ -96,15 +105,12 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   arm_b_.resize(m);
   rows_.resize(m);
   u_.resize(3 * m);
-  auto point_velocity = [&](int body, const Vec3& arm) -> Vec3 {
-    return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
-  };
   for (int k = 0; k < m; ++k) {
     const Contact& c = contacts[k];
     basis_[k] = contact_basis(c.normal);
     arm_a_[k] = c.point - pose.position[c.a];
     arm_b_[k] = c.point - pose.position[c.b];
-    u_.segment<3>(3 * k) = basis_[k].transpose() * (point_velocity(c.a, arm_a_[k]) - point_velocity(c.b, arm_b_[k]));
+    u_.segment<3>(3 * k) = basis_[k].transpose() * relative_velocity(c, arm_a_[k], arm_b_[k], velocity, angular);
     rows_[k].friction = 0.5 * (model_.friction[c.a] + model_.friction[c.b]);
     report.deepest = std::max(report.deepest, -c.distance);
   }
@@ -203,10 +209,7 @@ bool ContactResponse::correct(double h, std::vector<Vec3>& velocity, std::vector
   bool needed = false;
   for (int k = 0; k < m; ++k) {
     const Contact& c = contacts[k];
-    auto point_velocity = [&](int body, const Vec3& arm) -> Vec3 {
-      return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
-    };
-    u_.segment<3>(3 * k) = basis_[k].transpose() * (point_velocity(c.a, arm_a_[k]) - point_velocity(c.b, arm_b_[k]));
+    u_.segment<3>(3 * k) = basis_[k].transpose() * relative_velocity(c, arm_a_[k], arm_b_[k], velocity, angular);
     rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
     needed = needed || u_[3 * k] < rows_[k].target_normal - tolerance;
   }

@@ -127,6 +127,14 @@ inline Quat turned(const Vec3& theta, const Quat& q) {
   return Quat(rw * inverse_norm, rx * inverse_norm, ry * inverse_norm, rz * inverse_norm);
 }
 
+// Whether no moving component turns more than kMaxTurnPerStep in a step of h at angular velocities
+// `angular` (rad/s, world). False for a non-finite one too.
+bool turns_slowly_enough(const std::vector<Vec3>& angular, double h) {
+  double fastest = 0;
+  for (std::size_t i = 1; i < angular.size(); ++i) fastest = std::max(fastest, angular[i].squaredNorm());
+  return h * std::sqrt(fastest) <= kMaxTurnPerStep;
+}
+
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
 }  // namespace
@@ -240,9 +248,7 @@ bool Simulation::rattle(double h) {
   if (collisions_) {
     // A step that will be halved for turning too fast (checked again below, after the impulses) is
     // not worth a detection whose margins its speeds would make huge.
-    double spin = 0;
-    for (int i = 1; i < n; ++i) spin = std::max(spin, next.angular[i].squaredNorm());
-    if (!(h * std::sqrt(spin) <= kMaxTurnPerStep)) return false;
+    if (!turns_slowly_enough(next.angular, h)) return false;
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
@@ -286,9 +292,7 @@ bool Simulation::rattle(double h) {
   // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
   // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
   // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
-  double fastest = 0;
-  for (int i = 1; i < n; ++i) fastest = std::max(fastest, next.angular[i].squaredNorm());
-  if (!(h * std::sqrt(fastest) <= kMaxTurnPerStep)) return false;
+  if (!turns_slowly_enough(next.angular, h)) return false;
   for (int i = 1; i < n; ++i) {
     const Quat half = turned(0.5 * h * next.angular[i], now.orientation[i]);
     const Mat3 rot = half.toRotationMatrix();
