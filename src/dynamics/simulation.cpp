@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "dynamics/contact_response.hpp"
+#include "dynamics/step_size_rule.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace aloft {
@@ -28,10 +29,6 @@ constexpr double kJointTolerance = 1e-9;
 constexpr int kMaxJointIterations = 8;
 // A step whose joint impulses do not converge is split in two, recursively, at most this deep.
 constexpr int kMaxSubdivision = 8;
-// The largest turn (rad) of any component in one step. The drift's midpoint rotation is accurate to
-// O(turn^3); 0.05 rad keeps that below 1e-4 of the turn. A mobile swinging at a few rad/s turns ~0.005
-// rad per 1 ms step; a thin wire flung into a spin at hundreds of rad/s gets its step divided.
-constexpr double kMaxTurnPerStep = 0.05;
 // Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
 // millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
 // list from one step to the next without testing pieces that are far apart.
@@ -62,7 +59,8 @@ struct StepWorkspace {
         inverse_moments(model.count, Vec3::Zero()),
         response(model),
         pseudo(model.count, Vec6::Zero()),
-        probe(rest_state(model)) {
+        probe(rest_state(model)),
+        step_rule(model) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
     for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
   }
@@ -94,6 +92,7 @@ struct StepWorkspace {
   std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
   State probe;                    // the current pose with the half-step velocities, for detection
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
+  StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
 };
 
 namespace {
@@ -125,14 +124,6 @@ inline Quat turned(const Vec3& theta, const Quat& q) {
   const double norm2 = rw * rw + rx * rx + ry * ry + rz * rz;
   const double inverse_norm = std::abs(norm2 - 1.0) < 1e-8 ? 0.5 * (3.0 - norm2) : 1.0 / std::sqrt(norm2);
   return Quat(rw * inverse_norm, rx * inverse_norm, ry * inverse_norm, rz * inverse_norm);
-}
-
-// Whether no moving component turns more than kMaxTurnPerStep in a step of h at angular velocities
-// `angular` (rad/s, world). False for a non-finite one too.
-bool turns_slowly_enough(const std::vector<Vec3>& angular, double h) {
-  double fastest = 0;
-  for (std::size_t i = 1; i < angular.size(); ++i) fastest = std::max(fastest, angular[i].squaredNorm());
-  return h * std::sqrt(fastest) <= kMaxTurnPerStep;
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
@@ -246,9 +237,9 @@ bool Simulation::rattle(double h) {
   bool has_pseudo = false;
   ContactStepReport contact_report;
   if (collisions_) {
-    // A step that will be halved for turning too fast (checked again below, after the impulses) is
+    // A step that will be halved as too long for its spins (checked again below, after the impulses) is
     // not worth a detection whose margins its speeds would make huge.
-    if (!turns_slowly_enough(next.angular, h)) return false;
+    if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return false;
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
@@ -292,7 +283,7 @@ bool Simulation::rattle(double h) {
   // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
   // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
   // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
-  if (!turns_slowly_enough(next.angular, h)) return false;
+  if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return false;
   for (int i = 1; i < n; ++i) {
     const Quat half = turned(0.5 * h * next.angular[i], now.orientation[i]);
     const Mat3 rot = half.toRotationMatrix();
@@ -402,8 +393,8 @@ bool Simulation::rattle(double h) {
   return true;
 }
 
-// Advance by h, halving the step where RATTLE does not converge or turns a component too far (fast
-// spins, violent swings), down to h / 2^kMaxSubdivision.
+// Advance by h, halving the step where RATTLE does not converge or the step-size rule finds h too long
+// for the spins (step_size_rule.hpp), down to h / 2^kMaxSubdivision.
 bool Simulation::advance_by(double h, int depth) {
   if (rattle(h)) return true;
   if (depth == kMaxSubdivision) return false;
