@@ -3,6 +3,7 @@
 // not yet for meaning. compile() (model.hpp) turns it into the immutable Model. Everything is in world
 // coordinates at the designed rest pose (metres, y up).
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -66,6 +67,56 @@ struct ContactSpec {
   bool enabled = true;
 };
 
+// How a file wind source's speed v0 varies with time t (s, simulated, from the start of the run).
+enum class WindProfileKind {
+  Steady,   // v0 always
+  OnOff,    // a fan switched on and off: v0 for `on` s of every `period` s, ramping over `ramp` s
+  Swell,    // a vent that breathes: v0 (1 - depth (1 - cos(2 pi t' / period)) / 2), full at t' = 0
+};
+
+struct WindProfileSpec {
+  WindProfileKind kind = WindProfileKind::Steady;
+  double period = 10;                       // s (> 0): OnOff and Swell
+  double on = 5;                            // s (0 < on <= period): OnOff, from switch-on to switch-off
+  double ramp = 0;                          // s (0 <= ramp <= on, on + ramp <= period): OnOff, spin-up and
+                                            // run-down time (linear); the mean factor is on / period
+  double depth = 0.5;                       // 0..1: Swell, the fraction of v0 lost at the trough
+  double phase = 0;                         // s: t' = t + phase (where in its cycle the source starts)
+
+  // v0 multiplier at time t (s), in [0, 1]. OnOff: rises 0 -> 1 over [0, ramp), holds 1 until `on`,
+  // falls 1 -> 0 over [on, on + ramp), then 0 until the period ends (ramp = 0: a plain switch).
+  double factor(double t) const;
+};
+
+// A wind source the file places in the room (a fan, an air vent): the paper's cone with its disc S0
+// centred at `from`, blowing towards `to`, the vertex l0 behind S0 (WindSource::aimed(from, to, r0, l0)).
+struct WindSourceSpec {
+  std::string name;                         // shown in summaries and the viewer; default "source N"
+  Vec3 from = Vec3::Zero();                 // centre of S0, world, m
+  Vec3 to = Vec3::Zero();                   // a point on its axis that it blows towards, world, m (!= from)
+  double r0 = 0.25;                         // radius of S0, m (> 0)
+  double l0 = 1.0;                          // vertex to S0, m (> 0)
+  double speed = 0;                         // v0 at S0 at full strength, m/s (>= 0)
+  WindProfileSpec profile;
+  // Per-source overrides of the wind's settings (WindSettings); empty: the run's value.
+  std::optional<double> alpha;              // kg m (> 0); run default: air, kAirDensity * l0^4
+  std::optional<double> beta;               // turbulence bound, 0..10
+  std::optional<std::uint64_t> seed;        // of the turbulence
+  std::string path;                         // e.g. "wind_sources[0]"
+
+  double v0(double t) const { return speed * profile.factor(t); }   // m/s at time t (s)
+};
+
+// The camera a file suggests for `aloft render` and `aloft view` (command-line flags override each key).
+// Same meanings and ranges as the flags (apps/aloft/view/camera_flags.hpp); empty: the framing camera's.
+struct CameraSpec {
+  std::optional<double> yaw_deg;           // about +y, degrees; 0 faces the wall
+  std::optional<double> pitch_deg;         // above the horizontal, degrees, -85..85
+  std::optional<double> distance;          // m from the target (> 0)
+  std::optional<double> fov_deg;           // vertical field of view, degrees, 5..120
+  std::optional<Vec3> target;              // world point it looks at, m
+};
+
 struct MobileSpec {
   std::string file;                         // path of the mobile file as opened ("" for a string)
   std::string name;
@@ -77,6 +128,8 @@ struct MobileSpec {
   double timestep = 0.001;                  // s, the fixed physics step
   double joint_tolerance = 0.005;           // m: a joint must lie this close to both parts it joins
   std::vector<ComponentSpec> components;
+  std::vector<WindSourceSpec> wind_sources;  // steady sources placed by the file (none by default)
+  std::optional<CameraSpec> camera;         // the file's camera, if it has one
   SourceMap source;
 
   // An InputError at `path` in this file, with its line where known.
@@ -85,7 +138,8 @@ struct MobileSpec {
 
 // Parse a mobile file. Throws InputError (file, JSON path, line, problem) for unreadable files, JSON
 // syntax errors, missing or unknown keys, wrong types, non-finite or non-positive sizes, bad colours,
-// malformed or missing OBJ meshes (paths relative to the mobile file). Meaning across components
+// bad wind sources (from == to, r0 or l0 not positive, negative speed, a profile out of range) or camera
+// values out of range, malformed or missing OBJ meshes (paths relative to the mobile file). Meaning across components
 // (parents, cycles, the fixed component, balance) is compile()'s job.
 MobileSpec parse_mobile_file(const std::string& path);
 

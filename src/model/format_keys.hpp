@@ -8,9 +8,9 @@
 
 namespace aloft::internal::format_keys {
 
-inline constexpr std::array<std::string_view, 10> kMobile = {
+inline constexpr std::array<std::string_view, 12> kMobile = {
     "name", "aloft", "gravity", "balance", "density", "damping", "contact", "timestep", "joint_tolerance",
-    "components"};
+    "components", "wind_sources", "camera"};
 inline constexpr std::array<std::string_view, 2> kBalance = {"mode", "total_mass"};
 inline constexpr std::array<std::string_view, 2> kDamping = {"linear", "angular"};
 inline constexpr std::array<std::string_view, 3> kContact = {"restitution", "friction", "enabled"};
@@ -27,5 +27,12 @@ inline constexpr std::array<std::string_view, 2> kRotation = {"axis", "degrees"}
 inline constexpr std::array<std::string_view, 6> kPlate = {"points", "thickness", "plane", "x", "y", "z"};
 inline constexpr std::array<std::string_view, 3> kPlaneFrame = {"origin", "u", "v"};
 inline constexpr std::array<std::string_view, 3> kMesh = {"obj", "scale", "translate"};
+// A steady wind source (a fan, an air vent) and its time profile. Of the profile's keys, only those of
+// its "type" are accepted: "steady" none, "on_off" period, on, ramp, phase; "swell" period, depth, phase.
+inline constexpr std::array<std::string_view, 10> kWindSource = {
+    "name", "from", "to", "r0", "l0", "speed", "profile", "alpha", "beta", "seed"};
+inline constexpr std::array<std::string_view, 6> kWindProfile = {"type", "period", "on", "ramp", "depth", "phase"};
+// The file's camera (degrees and metres, as the --yaw, --pitch, --distance, --fov, --target flags).
+inline constexpr std::array<std::string_view, 5> kCamera = {"yaw", "pitch", "distance", "fov", "target"};
 
 }  // namespace aloft::internal::format_keys

@@ -354,8 +354,27 @@ class Reader {
     return x;
   }
 
+  // A number in [lo, hi] (both finite).
+  double in_range(const json& v, const Path& path, double lo, double hi, std::string_view unit) const {
+    const double x = v.is_number() ? v.get<double>() : lo - 1;
+    if (!v.is_number() || !(x >= lo && x <= hi))
+      fail(path, "must be a number from " + format_number(lo) + " to " + format_number(hi) + unit_suffix(unit) +
+                     ", got " + describe(v));
+    return x;
+  }
+
+  // A whole number from 0 to 2^63 - 1 (seeds).
+  std::uint64_t count(const json& v, const Path& path) const {
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() <= static_cast<std::uint64_t>(INT64_MAX))
+      return v.get<std::uint64_t>();
+    fail(path, "must be a whole number from 0 to 2^63 - 1, got " + describe(v));
+  }
+
   void balance(const json& v, const Path& path);
   void damping(const json& v, const Path& path);
+  WindSourceSpec wind_source(const json& v, const Path& path, std::size_t index) const;
+  WindProfileSpec wind_profile(const json& v, const Path& path) const;
+  CameraSpec camera(const json& v, const Path& path) const;
   void contact(const json& v, const Path& path);
   ComponentSpec component(const json& v, const Path& path);
   Color color(const json& v, const Path& path) const;
@@ -402,6 +421,97 @@ void Reader::mobile(const json& root) {
   if (!list.is_array() || list.empty()) fail(cp, "must be a non-empty array of components, got " + describe(list));
   spec_.components.reserve(list.size());
   for (std::size_t i = 0; i < list.size(); ++i) spec_.components.push_back(component(list[i], item(cp, i)));
+
+  if (const json* v = find(root, "wind_sources")) {
+    const Path wp = join(top, "wind_sources");
+    if (!v->is_array()) fail(wp, "must be an array of wind sources [{...}, ...], got " + describe(*v));
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      WindSourceSpec w = wind_source((*v)[i], item(wp, i), i);
+      for (const WindSourceSpec& other : spec_.wind_sources)
+        if (other.name == w.name)
+          fail(join(item(wp, i), "name"), "the name " + quote_json(w.name) + " is already used by " + other.path);
+      spec_.wind_sources.push_back(std::move(w));
+    }
+  }
+  if (const json* v = find(root, "camera")) spec_.camera = camera(*v, join(top, "camera"));
+}
+
+WindSourceSpec Reader::wind_source(const json& v, const Path& path, std::size_t index) const {
+  object(v, path, "a wind source with \"from\", \"to\" and \"speed\"");
+  check_keys(v, path, format_keys::kWindSource);
+  WindSourceSpec w;
+  w.path = path.str();
+  w.name = "source " + std::to_string(index + 1);
+  if (const json* x = find(v, "name")) w.name = text(*x, join(path, "name"));
+  w.from = vec3(require(v, path, "from", "[x, y, z] in m: the centre of the source's disc S0"), join(path, "from"), "m");
+  w.to = vec3(require(v, path, "to", "[x, y, z] in m: a point it blows towards"), join(path, "to"), "m");
+  if (!((w.to - w.from).norm() > 0))
+    fail(join(path, "to"), "must differ from \"from\" (the wind blows from \"from\" towards \"to\")");
+  if (const json* x = find(v, "r0")) w.r0 = positive(*x, join(path, "r0"), "m, the radius of the disc S0");
+  if (const json* x = find(v, "l0")) w.l0 = positive(*x, join(path, "l0"), "m, from the cone's vertex to S0");
+  w.speed = non_negative(require(v, path, "speed", "m/s, the wind speed v0 at the disc S0"), join(path, "speed"), "m/s");
+  if (const json* x = find(v, "profile")) w.profile = wind_profile(*x, join(path, "profile"));
+  if (const json* x = find(v, "alpha")) w.alpha = positive(*x, join(path, "alpha"), "kg m");
+  if (const json* x = find(v, "beta")) w.beta = in_range(*x, join(path, "beta"), 0, 10, "");
+  if (const json* x = find(v, "seed")) w.seed = count(*x, join(path, "seed"));
+  return w;
+}
+
+WindProfileSpec Reader::wind_profile(const json& v, const Path& path) const {
+  object(v, path, "with \"type\": \"steady\", \"on_off\" or \"swell\"");
+  check_keys(v, path, format_keys::kWindProfile);
+  WindProfileSpec p;
+  const Path tp = join(path, "type");
+  const json& type = require(v, path, "type", "\"steady\", \"on_off\" or \"swell\"");
+  std::vector<std::string_view> keys;  // the keys this type takes besides "type"
+  if (type == "steady") {
+    p.kind = WindProfileKind::Steady;
+  } else if (type == "on_off") {
+    p.kind = WindProfileKind::OnOff;
+    keys = {"period", "on", "ramp", "phase"};
+  } else if (type == "swell") {
+    p.kind = WindProfileKind::Swell;
+    keys = {"period", "depth", "phase"};
+  } else {
+    fail(tp, "must be \"steady\", \"on_off\" or \"swell\", got " + describe(type));
+  }
+  for (std::string_view key : format_keys::kWindProfile) {
+    if (key != "type" && find(v, key) && std::find(keys.begin(), keys.end(), key) == keys.end())
+      fail_key(path, key, "unknown key " + quote_json(key) + " (with \"type\": " + describe(type) +
+                              (keys.empty() ? std::string(" there are no other keys)")
+                                            : " the keys are: type, " + key_list(keys) + ")"));
+  }
+  if (p.kind == WindProfileKind::Steady) return p;
+  p.period = positive(require(v, path, "period", "s, the length of one cycle"), join(path, "period"), "s");
+  if (const json* x = find(v, "phase")) p.phase = number(*x, join(path, "phase"), "s");
+  if (p.kind == WindProfileKind::Swell) {
+    if (const json* x = find(v, "depth")) p.depth = fraction(*x, join(path, "depth"));
+    return p;
+  }
+  const Path op = join(path, "on");
+  p.on = positive(require(v, path, "on", "s of each period from switch-on to switch-off"), op, "s");
+  if (p.on > p.period) fail(op, "must be at most \"period\" (" + format_number(p.period) + " s), got " + describe(v.at("on")));
+  if (const json* x = find(v, "ramp")) {
+    const Path rp = join(path, "ramp");
+    p.ramp = non_negative(*x, rp, "s");
+    if (p.ramp > p.on) fail(rp, "must be at most \"on\" (" + format_number(p.on) + " s): the fan spins up while on");
+    if (p.on + p.ramp > p.period)
+      fail(rp, "\"on\" + \"ramp\" must be at most \"period\" (" + format_number(p.period) +
+                   " s): the fan runs down before the next cycle");
+  }
+  return p;
+}
+
+CameraSpec Reader::camera(const json& v, const Path& path) const {
+  object(v, path, "with any of \"yaw\", \"pitch\", \"distance\", \"fov\", \"target\"");
+  check_keys(v, path, format_keys::kCamera);
+  CameraSpec c;
+  if (const json* x = find(v, "yaw")) c.yaw_deg = number(*x, join(path, "yaw"), "degrees");
+  if (const json* x = find(v, "pitch")) c.pitch_deg = in_range(*x, join(path, "pitch"), -85, 85, "degrees");
+  if (const json* x = find(v, "distance")) c.distance = positive(*x, join(path, "distance"), "m");
+  if (const json* x = find(v, "fov")) c.fov_deg = in_range(*x, join(path, "fov"), 5, 120, "degrees");
+  if (const json* x = find(v, "target")) c.target = vec3(*x, join(path, "target"), "m");
+  return c;
 }
 
 void Reader::balance(const json& v, const Path& path) {

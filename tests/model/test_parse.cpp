@@ -684,7 +684,9 @@ TEST(ParseFormatSchema, ListsExactlyTheKeysTheParserAccepts) {
       {"balance", set_of(k::kBalance)}, {"damping", set_of(k::kDamping)},   {"contact", set_of(k::kContact)},
       {"component", set_of(k::kComponent)}, {"shape", set_of(k::kShape)},   {"sphere", set_of(k::kSphere)},
       {"wire", set_of(k::kWire)},       {"box", set_of(k::kBox)},           {"rotation", set_of(k::kRotation)},
-      {"plate", set_of(k::kPlate)},     {"plane_frame", set_of(k::kPlaneFrame)}, {"mesh", set_of(k::kMesh)}};
+      {"plate", set_of(k::kPlate)},     {"plane_frame", set_of(k::kPlaneFrame)}, {"mesh", set_of(k::kMesh)},
+      {"wind_source", set_of(k::kWindSource)}, {"wind_profile", set_of(k::kWindProfile)},
+      {"camera", set_of(k::kCamera)}};
   for (const auto& [name, keys] : objects) {
     SCOPED_TRACE(name);
     ASSERT_TRUE(defs.contains(name));
@@ -720,6 +722,194 @@ sys.exit(0 if ok and not v.is_valid(json.load(open(sys.argv[2]))) else 1)
                         bad.string() + "'";
   for (const auto& p : good) command += " '" + p.string() + "'";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Wind sources placed by the file ("wind_sources") and the file's camera ("camera").
+
+// A one-component mobile (just the hook) with `keys` (top-level "key": value pairs) on lines 3 onwards.
+std::string with_top_keys(const std::string& keys) {
+  return "{\n  \"name\": \"test\",\n" + keys +
+         ",\n  \"components\": [\n    {\"name\": \"hook\", \"fixed\": true,"
+         " \"shapes\": [{\"sphere\": {\"center\": [0, 1, 0], \"radius\": 0.01}}]}\n  ]\n}\n";
+}
+
+TEST(ParseScene, WindSourcesAndCameraHaveTheirValuesAndDefaults) {
+  const std::string text = with_top_keys(R"(  "wind_sources": [
+    {"name": "fan", "from": [1, 1.5, 0.5], "to": [0, 1.5, 0], "r0": 0.2, "l0": 0.8, "speed": 3.5,
+     "alpha": 0.6, "beta": 0, "seed": 42},
+    {"from": [0, 0.2, 0], "to": [0, 2, 0], "speed": 1,
+     "profile": {"type": "on_off", "period": 10, "on": 6, "ramp": 2, "phase": 1}},
+    {"name": "vent", "from": [-1, 1, 0], "to": [0, 1, 0], "speed": 0,
+     "profile": {"type": "swell", "period": 4}},
+    {"name": "still", "from": [-1, 1, 1], "to": [0, 1, 1], "speed": 2, "profile": {"type": "steady"}}
+  ],
+  "camera": {"yaw": -30, "pitch": 12.5, "distance": 3, "fov": 40, "target": [0.1, 1.2, -0.1]})");
+  const MobileSpec spec = parse_mobile_text(text, "scene.json");
+  ASSERT_EQ(spec.wind_sources.size(), 4u);
+  const WindSourceSpec& fan = spec.wind_sources[0];
+  EXPECT_EQ(fan.name, "fan");
+  EXPECT_EQ(fan.path, "wind_sources[0]");
+  EXPECT_EQ(fan.from, Vec3(1, 1.5, 0.5));
+  EXPECT_EQ(fan.to, Vec3(0, 1.5, 0));
+  EXPECT_EQ(fan.r0, 0.2);
+  EXPECT_EQ(fan.l0, 0.8);
+  EXPECT_EQ(fan.speed, 3.5);
+  EXPECT_EQ(fan.profile.kind, WindProfileKind::Steady);
+  EXPECT_EQ(fan.alpha, 0.6);
+  EXPECT_EQ(fan.beta, 0.0);
+  EXPECT_EQ(fan.seed, 42u);
+  const WindSourceSpec& fan2 = spec.wind_sources[1];
+  EXPECT_EQ(fan2.name, "source 2");  // default: "source N", N counted from 1
+  EXPECT_EQ(fan2.r0, 0.25);          // defaults: WindSource's r0 and l0
+  EXPECT_EQ(fan2.l0, 1.0);
+  EXPECT_FALSE(fan2.alpha);
+  EXPECT_FALSE(fan2.beta);
+  EXPECT_FALSE(fan2.seed);
+  EXPECT_EQ(fan2.profile.kind, WindProfileKind::OnOff);
+  EXPECT_EQ(fan2.profile.period, 10);
+  EXPECT_EQ(fan2.profile.on, 6);
+  EXPECT_EQ(fan2.profile.ramp, 2);
+  EXPECT_EQ(fan2.profile.phase, 1);
+  EXPECT_EQ(spec.wind_sources[2].profile.kind, WindProfileKind::Swell);
+  EXPECT_EQ(spec.wind_sources[2].profile.depth, 0.5);  // default depth
+  EXPECT_EQ(spec.wind_sources[2].speed, 0);            // a fan switched off is allowed
+  EXPECT_EQ(spec.wind_sources[3].profile.kind, WindProfileKind::Steady);
+  ASSERT_TRUE(spec.camera);
+  EXPECT_EQ(spec.camera->yaw_deg, -30.0);
+  EXPECT_EQ(spec.camera->pitch_deg, 12.5);
+  EXPECT_EQ(spec.camera->distance, 3.0);
+  EXPECT_EQ(spec.camera->fov_deg, 40.0);
+  EXPECT_EQ(spec.camera->target, Vec3(0.1, 1.2, -0.1));
+
+  // Every key of the camera is optional; no "camera" and no "wind_sources" are the defaults.
+  const MobileSpec partial = parse_mobile_text(with_top_keys(R"(  "camera": {"pitch": -85})"));
+  ASSERT_TRUE(partial.camera);
+  EXPECT_EQ(partial.camera->pitch_deg, -85.0);
+  EXPECT_FALSE(partial.camera->yaw_deg || partial.camera->distance || partial.camera->fov_deg || partial.camera->target);
+  const MobileSpec none = parse_mobile_text(with_top_keys(R"(  "density": 1000)"));
+  EXPECT_FALSE(none.camera);
+  EXPECT_TRUE(none.wind_sources.empty());
+  EXPECT_TRUE(parse_mobile_text(with_top_keys(R"(  "wind_sources": [])")).wind_sources.empty());
+}
+
+TEST(ParseScene, WindProfilesGiveTheirSpeedFactor) {
+  WindProfileSpec p;
+  EXPECT_EQ(p.factor(123.4), 1);  // steady
+  p.kind = WindProfileKind::OnOff;
+  p.period = 10;
+  p.on = 6;
+  p.ramp = 2;
+  // Rise over [0, 2), full until 6, fall over [6, 8), still until 10; then again. Exact arithmetic on
+  // these binary-friendly times up to one rounding of fmod/division: 1e-12.
+  const std::pair<double, double> on_off[] = {{0, 0},   {1, 0.5}, {2, 1},  {5.9, 1},  {6, 1},   {7, 0.5},
+                                              {8, 0},   {9.5, 0}, {11, 0.5}, {-9, 0.5}, {27, 0.5}};
+  for (const auto& [t, f] : on_off) EXPECT_NEAR(p.factor(t), f, 1e-12) << "t = " << t;
+  p.phase = 1;  // starts 1 s into its cycle
+  EXPECT_NEAR(p.factor(0), 0.5, 1e-12);
+  p.phase = 0;
+  p.ramp = 0;  // a plain switch
+  EXPECT_EQ(p.factor(0), 1);
+  EXPECT_EQ(p.factor(5.999), 1);
+  EXPECT_EQ(p.factor(6), 0);
+  // The mean over a period is on / period (the doc's promise), with or without a ramp: midpoint rule on
+  // 10^5 points, exact for the piecewise-linear profile up to the kinks' cells, 1e-4.
+  for (double ramp : {0.0, 2.0, 4.0}) {
+    p.ramp = ramp;
+    double sum = 0;
+    constexpr int kN = 100000;
+    for (int i = 0; i < kN; ++i) sum += p.factor((i + 0.5) * p.period / kN);
+    EXPECT_NEAR(sum / kN, 0.6, 1e-4) << "ramp " << ramp;
+  }
+  WindProfileSpec swell;
+  swell.kind = WindProfileKind::Swell;
+  swell.period = 4;
+  swell.depth = 0.3;
+  EXPECT_NEAR(swell.factor(0), 1, 1e-12);    // full at the start of its cycle
+  EXPECT_NEAR(swell.factor(2), 0.7, 1e-12);  // 1 - depth at half the period
+  EXPECT_NEAR(swell.factor(1), 0.85, 1e-12); // halfway down (cos 90 deg = 0)
+  EXPECT_NEAR(swell.factor(4), 1, 1e-12);
+  WindSourceSpec source;
+  source.speed = 2;
+  source.profile = swell;
+  EXPECT_NEAR(source.v0(2), 1.4, 1e-12);
+}
+
+TEST(ParseScene, BadWindSourcesAndCamerasNameFilePathAndLine) {
+  struct Case {
+    std::string keys;        // top-level keys
+    std::string path;        // the JSON path in the message
+    std::string line_at;     // text on the line the message must name
+    std::string problem;     // part of the problem
+  };
+  const std::string fan = R"("from": [1, 1, 0], "to": [0, 1, 0], "speed": 2)";
+  const Case cases[] = {
+      {R"(  "wind_sources": {"from": [1, 1, 0]})", "wind_sources", "\"wind_sources\"", "must be an array of wind sources"},
+      {R"(  "wind_sources": [3])", "wind_sources[0]", "\"wind_sources\"", "must be an object"},
+      {"  \"wind_sources\": [\n    {" + fan + R"(, "sped": 2}])", "wind_sources[0]", "\"sped\"",
+       "unknown key \"sped\" (did you mean \"speed\"?)"},
+      {R"(  "wind_sources": [{"to": [0, 1, 0], "speed": 2}])", "wind_sources[0]", "\"wind_sources\"", "missing key \"from\""},
+      {R"(  "wind_sources": [{"from": [1, 1, 0], "to": [0, 1, 0]}])", "wind_sources[0]", "\"wind_sources\"",
+       "missing key \"speed\""},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"r0\": \"wide\"}]", "wind_sources[0].r0", "\"wide\"",
+       "must be a positive number (m, the radius of the disc S0), got \"wide\""},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"r0\": 0}]", "wind_sources[0].r0", "\"r0\"", "must be a positive number"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"l0\": -1}]", "wind_sources[0].l0", "\"l0\"", "must be a positive number"},
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [0, 1, 0],\n     \"speed\": -0.5}]",
+       "wind_sources[0].speed", "\"speed\"", "must be a number >= 0 (m/s), got -0.5"},
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [0, 1, 0],\n     \"speed\": true}]",
+       "wind_sources[0].speed", "\"speed\"", "got true"},
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1e999, 0], \"to\": [0, 1, 0], \"speed\": 1}]",
+       "wind_sources[0].from[1]", "1e999", "must be a finite number, got 1e999"},
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [1, 1, 0], \"speed\": 1}]",
+       "wind_sources[0].to", "\"to\"", "must differ from \"from\""},
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1], \"to\": [0, 1, 0], \"speed\": 1}]",
+       "wind_sources[0].from", "\"from\"", "must be an array of 3 numbers [x, y, z] (m), got an array of 2 values"},
+      {"  \"wind_sources\": [\n    {" + fan + ", \"name\": \"a\"},\n    {" + fan + ", \"name\": \"a\"}]",
+       "wind_sources[1].name", "}]", "the name \"a\" is already used by wind_sources[0]"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"beta\": 11}]", "wind_sources[0].beta", "\"beta\"",
+       "must be a number from 0 to 10, got 11"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"alpha\": 0}]", "wind_sources[0].alpha", "\"alpha\"",
+       "must be a positive number (kg m)"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"seed\": -1}]", "wind_sources[0].seed", "\"seed\"",
+       "must be a whole number from 0 to 2^63 - 1, got -1"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"seed\": 1.5}]", "wind_sources[0].seed", "\"seed\"",
+       "must be a whole number"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"pulse\"}}]",
+       "wind_sources[0].profile.type", "\"profile\"", "must be \"steady\", \"on_off\" or \"swell\", got \"pulse\""},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"period\": 3}}]",
+       "wind_sources[0].profile", "\"profile\"", "missing key \"type\""},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"on_off\", \"on\": 2}}]",
+       "wind_sources[0].profile", "\"profile\"", "missing key \"period\""},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"on_off\", \"period\": 4, \"on\": 5}}]",
+       "wind_sources[0].profile.on", "\"profile\"", "must be at most \"period\" (4 s), got 5"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"on_off\", \"period\": 4, \"on\": 1, \"ramp\": 2}}]",
+       "wind_sources[0].profile.ramp", "\"profile\"", "must be at most \"on\" (1 s)"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"on_off\", \"period\": 4, \"on\": 3, \"ramp\": 2}}]",
+       "wind_sources[0].profile.ramp", "\"profile\"", "\"on\" + \"ramp\" must be at most \"period\" (4 s)"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"on_off\", \"period\": 4, \"on\": 2, \"depth\": 0.5}}]",
+       "wind_sources[0].profile", "\"profile\"", "unknown key \"depth\" (with \"type\": \"on_off\" the keys are: type, period, on, ramp, phase)"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"swell\", \"period\": 4, \"depth\": 1.5}}]",
+       "wind_sources[0].profile.depth", "\"profile\"", "must be a number from 0 to 1, got 1.5"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"profile\": {\"type\": \"steady\", \"period\": 4}}]",
+       "wind_sources[0].profile", "\"profile\"", "unknown key \"period\" (with \"type\": \"steady\" there are no other keys)"},
+      {R"(  "camera": [0, 1])", "camera", "\"camera\"", "must be an object"},
+      {"  \"camera\": {\"yaw\": 10,\n    \"pitch\": 90}", "camera.pitch", "\"pitch\"",
+       "must be a number from -85 to 85 (degrees), got 90"},
+      {"  \"camera\": {\"yaw\": 10,\n    \"fov\": 2}", "camera.fov", "\"fov\"", "must be a number from 5 to 120 (degrees), got 2"},
+      {"  \"camera\": {\"yaw\": 10,\n    \"distance\": 0}", "camera.distance", "\"distance\"",
+       "must be a positive number (m), got 0"},
+      {"  \"camera\": {\"yaw\": \"left\"}", "camera.yaw", "\"camera\"", "must be a number (degrees), got \"left\""},
+      {"  \"camera\": {\"yaw\": 10,\n    \"target\": [0, 1e999, 0]}", "camera.target[1]", "\"target\"",
+       "must be a finite number"},
+      {"  \"camera\": {\"yaw\": 10,\n    \"zoom\": 2}", "camera", "\"zoom\"", "unknown key \"zoom\" (expected one of: yaw, pitch, distance, fov, target)"},
+      {"  \"wind_source\": []", "", "\"wind_source\"", "unknown key \"wind_source\" (did you mean \"wind_sources\"?)"},
+  };
+  for (const Case& c : cases) {
+    const std::string text = with_top_keys(c.keys);
+    SCOPED_TRACE(text);
+    expect_error(text, c.path, line_of(text, c.line_at), c.problem);
+  }
 }
 
 }  // namespace
