@@ -110,21 +110,20 @@ Runner add_render(CLI::App& app) {
       "  aloft render mobiles/steel-fish.json -t 2 --out frames/ --yaw 30 --pitch 20 --distance 5\n"
       "  aloft render mobiles/steel-fish.json -t 8 --wind 2 --out breeze.mp4   # a steady breath from the front\n"
       "\n"
-      "Wind: as in 'aloft simulate' (--wind, --wind-speed, --wind-audio and the source flags).\n");
+      "Wind: as in 'aloft simulate' (--wind, --wind-speed, --wind-audio and the source flags); the mobile\n"
+      "file's \"wind_sources\" blow too, unless --no-file-wind.\n"
+      "Camera: the mobile file's \"camera\" where it has one; each camera flag overrides its key.\n");
   return [o] {
-    const Model model = load_mobile_as(o->file, o->balance);
+    const LoadedMobile loaded = load_mobile_with_spec(o->file, o->balance);
+    const Model& model = loaded.model;
     Simulation sim(model);
-    std::optional<WindDriver> wind = make_wind(model, sim.state(), o->wind, sim.timestep());
+    WindSet wind(model, loaded.spec, sim.state(), o->wind, sim.timestep());
     long long steps = 0;
-    // Physics up to simulated time t: the wind's occlusion refreshed every refresh_every steps, its forces
-    // applied at every step (as 'aloft simulate' does).
+    // Physics up to simulated time t: each wind's occlusion refreshed every refresh_every steps, the
+    // forces applied at every step (as 'aloft simulate' does).
     const auto advance_to = [&](double t) {
       while (sim.state().time < t - 0.5 * sim.timestep()) {
-        if (wind) {
-          if (steps % wind->refresh_every == 0) wind->wind->refresh_occlusion(sim.state());
-          sim.loads().clear();
-          wind->wind->apply(sim.state(), wind->v0(sim.state().time), sim.timestep(), sim.loads());
-        }
+        wind.apply(steps, sim.state(), sim.timestep(), sim.loads());
         if (!sim.step()) return false;
         ++steps;
       }
@@ -137,7 +136,8 @@ Runner add_render(CLI::App& app) {
     render::FrameTarget target;
     target.resize(o->width, o->height, o->samples);
     const render::OrbitCamera camera =
-        o->camera.apply(render::framing_camera(renderer.scene(), static_cast<double>(o->width) / o->height));
+        o->camera.apply(loaded.spec.camera,
+                        render::framing_camera(renderer.scene(), static_cast<double>(o->width) / o->height));
     render::DrawOptions options;
     options.shadows = !o->no_shadows;
 
@@ -180,7 +180,7 @@ Runner add_render(CLI::App& app) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o->quiet) {
       std::printf("mobile     %s\n", model.name.c_str());
-      if (wind) std::printf("wind       %s\n", wind->description.c_str());
+      for (const WindDriver& d : wind.drivers()) std::printf("wind       %s\n", d.description.c_str());
       std::printf("written    %s (%s, %.3g s simulated)\n", o->out.c_str(), written.c_str(), sim.state().time);
       std::printf("wall time  %.2f s (%.1f frames/s) on %s\n", wall, static_cast<double>(frames) / wall,
                   context.description().c_str());

@@ -173,7 +173,8 @@ Runner add_simulate(CLI::App& app) {
       "  aloft simulate mobiles/steel-fish.json -t 10 --wind 2.5        # a steady breath from the front\n"
       "  aloft simulate mobiles/steel-fish.json -t 10 --wind-audio blow.wav --wind-from 0.5,1.8,1.5\n"
       "\n"
-      "Wind: one of --wind, --wind-speed or --wind-audio switches it on. The source disc S0 sits at\n"
+      "Wind: the mobile file's \"wind_sources\" (fans, vents) always blow, unless --no-file-wind.\n"
+      "One of --wind, --wind-speed or --wind-audio adds a wind from the flags. The source disc S0 sits at\n"
       "--wind-from (default 1.5 m in front, +z, of the mobile's centre) and blows towards --wind-to (default\n"
       "the mobile's centre); the cone's vertex is l0 behind S0. Occlusion is recomputed --wind-refresh times\n"
       "per simulated second; the wind's force and torque are applied at every step. See docs/wind.md.\n"
@@ -181,16 +182,14 @@ Runner add_simulate(CLI::App& app) {
       "Exit code 3 if the simulation fails (its state stops being finite); the CSV then holds the\n"
       "frames computed until then.\n");
   return [o] {
-    Model model = load_mobile_as(o->file, o->balance);
+    LoadedMobile loaded = load_mobile_with_spec(o->file, o->balance);
+    Model& model = loaded.model;
     if (o->no_collisions) model.contact.enabled = false;
     Simulation sim(model);
     if (o->dt > 0) sim.set_timestep(o->dt);
     if (o->damping_off) sim.set_damping(DampingSpec{});
     const double h = sim.timestep();
-    std::optional<WindDriver> wind = make_wind(model, sim.state(), o->wind, h);
-    double occlusion_seconds = 0;    // wall time spent in refresh_occlusion
-    long long refreshes = 0;
-    std::size_t elements = 0;        // summed over refreshes
+    WindSet wind(model, loaded.spec, sim.state(), o->wind, h);
     double largest_move = 0, largest_turn = 0;
     const long long steps = std::max(1LL, static_cast<long long>(std::ceil(o->duration / h - 1e-9)));
 
@@ -209,17 +208,7 @@ Runner add_simulate(CLI::App& app) {
     bool ok = true;
     long long done = 0;
     while (done < steps) {
-      if (wind) {
-        if (done % wind->refresh_every == 0) {
-          const auto t0 = Clock::now();
-          wind->wind->refresh_occlusion(sim.state());
-          occlusion_seconds += seconds_since(t0);
-          ++refreshes;
-          elements += wind->wind->elements().size();
-        }
-        sim.loads().clear();
-        wind->wind->apply(sim.state(), wind->v0(sim.state().time), h, sim.loads());
-      }
+      wind.apply(done, sim.state(), h, sim.loads());
       if (!sim.step()) {
         ok = false;
         break;
@@ -270,12 +259,18 @@ Runner add_simulate(CLI::App& app) {
       std::printf("joint separation  %.3e m (largest seen)\n", worst_separation);
       std::printf("motion            %.3g m largest displacement, %.3g deg largest turn (from rest, every %d steps)\n",
                   largest_move, largest_turn * 180 / 3.141592653589793, o->every);
-      if (wind) {
-        std::printf("wind              %s\n", wind->description.c_str());
+      for (const WindDriver& d : wind.drivers()) std::printf("wind              %s\n", d.description.c_str());
+      if (!wind.empty()) {
+        const long long refreshes = wind.refreshes();
+        const double occlusion = wind.occlusion_seconds();
         std::printf("occlusion         %lld refreshes, %.3f ms each (mean), %.0f elements each (mean), %.1f %% of the wall time\n",
-                    refreshes, refreshes ? 1e3 * occlusion_seconds / refreshes : 0.0,
-                    refreshes ? static_cast<double>(elements) / refreshes : 0.0, wall > 0 ? 100 * occlusion_seconds / wall : 0.0);
+                    refreshes, refreshes ? 1e3 * occlusion / refreshes : 0.0,
+                    refreshes ? static_cast<double>(wind.elements()) / refreshes : 0.0,
+                    wall > 0 ? 100 * occlusion / wall : 0.0);
       }
+      if (o->wind.no_file_wind && !loaded.spec.wind_sources.empty())
+        std::printf("file wind         %zu source(s) in the file ignored (--no-file-wind)\n",
+                    loaded.spec.wind_sources.size());
       if (csv)
         std::printf("trajectory        %s (%lld frames x %d components)\n", o->out.c_str(), done / o->every + 1,
                     model.count);

@@ -7,6 +7,7 @@
 #include "common.hpp"
 #include "view/camera_flags.hpp"
 #include "view/viewer.hpp"
+#include "wind_options.hpp"
 
 namespace aloft::cli {
 
@@ -18,6 +19,7 @@ Runner add_view(CLI::App& app) {
     bool no_shadows = false;
     bool no_wind = false;
     bool no_mic = false;
+    bool no_file_wind = false;
   };
   auto o = std::make_shared<Options>();
   o->viewer.file = source_dir() + "/mobiles/steel-fish.json";
@@ -40,6 +42,7 @@ Runner add_view(CLI::App& app) {
       ->check(CLI::Range(0.0, 20.0));
   sub->add_flag("--no-wind", o->no_wind, "Start with the wind off (W toggles it)");
   sub->add_flag("--no-mic", o->no_mic, "Do not open the microphone");
+  add_no_file_wind_flag(sub, o->no_file_wind);
   sub->add_flag("--show-cone", o->viewer.show_cone, "Show the wind's cone from the start (K toggles it)");
   sub->add_flag("--show-occlusion", o->viewer.show_occlusion,
                 "Show what the wind reaches (the occlusion result) from the start (O toggles it)");
@@ -72,6 +75,10 @@ Runner add_view(CLI::App& app) {
       "shown is reloaded whenever it changes on disk, and errors in it are shown in the window while the\n"
       "last good mobile keeps moving. Without a display, use 'aloft render'.\n"
       "\n"
+      "The mobile file's \"camera\" sets the starting camera (and the one C goes back to); each camera\n"
+      "flag overrides its key. The file's \"wind_sources\" (fans, vents) blow along with your own wind;\n"
+      "the panel lists them, each with its switch (--no-file-wind: all start off).\n"
+      "\n"
       "Examples:\n"
       "  aloft view\n"
       "  aloft view mobiles/southern-cross.json --breeze 1.5\n"
@@ -85,6 +92,7 @@ Runner add_view(CLI::App& app) {
     options.shadows = !o->no_shadows;
     options.wind = !o->no_wind;
     options.microphone = !o->no_mic;
+    options.file_wind = !o->no_file_wind;
     const CameraFlags camera = o->camera;
     options.adjust_camera = [camera](render::OrbitCamera c) { return camera.apply(c); };
     if (options.drop_frame >= 0 && options.drop_file.empty()) throw Failure("--drop-at needs --drop-file");

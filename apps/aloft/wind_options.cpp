@@ -1,8 +1,9 @@
-// The wind flags of `aloft simulate`.
+// The wind flags of `aloft simulate` and `aloft render`, and the winds they build (flags and file).
 
 #include "wind_options.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -71,6 +72,33 @@ std::pair<Vec3, double> mobile_sphere(const Model& model, const State& state) {
 }
 
 std::string point_text(const Vec3& p) { return format("(%.3g, %.3g, %.3g)", p.x(), p.y(), p.z()); }
+
+// The settings the flags give every wind (file sources may override alpha, beta and seed).
+WindSettings settings_from_flags(const WindOptions& o) {
+  WindSettings settings;
+  settings.alpha = o.alpha;
+  settings.beta = o.beta;
+  settings.correlation_time = o.gust_time;
+  settings.seed = static_cast<std::uint64_t>(o.seed);
+  settings.resolution = o.resolution;
+  settings.tile_pixels = std::min(o.tile, o.resolution);
+  return settings;
+}
+
+int refresh_steps(const WindOptions& o, double timestep) {
+  return std::max(1, static_cast<int>(std::lround(1.0 / (o.refresh * timestep))));
+}
+
+std::string profile_text(const WindProfileSpec& p) {
+  switch (p.kind) {
+    case WindProfileKind::Steady: return "steady";
+    case WindProfileKind::OnOff:
+      return format("on %g s of every %g s (ramp %g s, phase %g s)", p.on, p.period, p.ramp, p.phase);
+    case WindProfileKind::Swell:
+      return format("swelling, down by %g %% every %g s (phase %g s)", 100 * p.depth, p.period, p.phase);
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -161,6 +189,13 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 60.0))
       ->group(group);
+  add_no_file_wind_flag(sub, o.no_file_wind);
+}
+
+void add_no_file_wind_flag(CLI::App* sub, bool& no_file_wind) {
+  sub->add_flag("--no-file-wind", no_file_wind,
+                "Ignore the wind sources of the mobile file (its \"wind_sources\": fans, vents)")
+      ->group("Wind (the paper's cone; see docs/wind.md)");
 }
 
 std::optional<WindDriver> make_wind(const Model& model, const State& state, const WindOptions& o, double timestep) {
@@ -178,19 +213,13 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
     const double sine = std::min(0.95, radius / reach);
     r0 = o.l0 * sine / std::sqrt(1 - sine * sine);
   }
-  WindSettings settings;
-  settings.alpha = o.alpha;
-  settings.beta = o.beta;
-  settings.correlation_time = o.gust_time;
-  settings.seed = static_cast<std::uint64_t>(o.seed);
-  settings.resolution = o.resolution;
-  settings.tile_pixels = std::min(o.tile, o.resolution);
+  const WindSettings settings = settings_from_flags(o);
   try {
     d.wind = std::make_unique<Wind>(model, WindSource::aimed(from, to, r0, o.l0), settings);
   } catch (const std::invalid_argument& e) {
     throw Failure(e.what());
   }
-  d.refresh_every = std::max(1, static_cast<int>(std::lround(1.0 / (o.refresh * timestep))));
+  d.refresh_every = refresh_steps(o, timestep);
 
   std::string speed;
   if (o.constant) {
@@ -216,6 +245,60 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
                                  point_text(from).c_str(), r0, o.l0, point_text(to).c_str(), d.wind->alpha(), o.beta,
                                  o.resolution, d.refresh_every);
   return d;
+}
+
+WindDriver make_file_wind(const Model& model, const WindSourceSpec& source, std::size_t index, const WindOptions& o,
+                          double timestep) {
+  WindSettings settings = settings_from_flags(o);
+  if (source.alpha) settings.alpha = *source.alpha;
+  if (source.beta) settings.beta = *source.beta;
+  settings.seed = source.seed ? *source.seed : static_cast<std::uint64_t>(o.seed) + 1 + index;
+  WindDriver d;
+  try {
+    d.wind = std::make_unique<Wind>(model, WindSource::aimed(source.from, source.to, source.r0, source.l0), settings);
+  } catch (const std::invalid_argument& e) {
+    throw Failure(model.file + ": " + source.path + ": " + e.what());
+  }
+  d.file_source = source;
+  d.refresh_every = refresh_steps(o, timestep);
+  d.description = format("\"%s\" (file): v0 = %g m/s, %s; S0 at %s r0 = %.3g m, l0 = %.3g m, towards %s; "
+                         "alpha = %.3g kg m, beta = %g",
+                         source.name.c_str(), source.speed, profile_text(source.profile).c_str(),
+                         point_text(source.from).c_str(), source.r0, source.l0, point_text(source.to).c_str(),
+                         d.wind->alpha(), settings.beta);
+  return d;
+}
+
+WindSet::WindSet(const Model& model, const MobileSpec& spec, const State& state, const WindOptions& o,
+                 double timestep) {
+  if (auto flags = make_wind(model, state, o, timestep)) drivers_.push_back(std::move(*flags));
+  if (o.no_file_wind) return;
+  for (std::size_t i = 0; i < spec.wind_sources.size(); ++i)
+    drivers_.push_back(make_file_wind(model, spec.wind_sources[i], i, o, timestep));
+}
+
+void WindSet::apply(long long step, const State& state, double h, ExternalLoads& loads) {
+  if (drivers_.empty()) return;
+  loads.clear();
+  for (WindDriver& d : drivers_) {
+    if (step % d.refresh_every == 0) {
+      const auto t0 = std::chrono::steady_clock::now();
+      d.wind->refresh_occlusion(state);
+      occlusion_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++refreshes_;
+      elements_ += d.wind->elements().size();
+    }
+    d.wind->apply(state, d.v0(state.time), h, loads);  // adds to the loads
+  }
+}
+
+LoadedMobile load_mobile_with_spec(const std::string& file, const std::string& balance_mode) {
+  MobileSpec spec = parse_mobile_file(file);
+  if (balance_mode == "mass") spec.balance.mode = BalanceMode::Mass;
+  if (balance_mode == "joints") spec.balance.mode = BalanceMode::Joints;
+  if (balance_mode == "none") spec.balance.mode = BalanceMode::None;
+  Model model = compile(spec);
+  return LoadedMobile{std::move(spec), std::move(model)};
 }
 
 }  // namespace aloft::cli

@@ -1,6 +1,7 @@
 #pragma once
 // Camera flags shared by `aloft render` and `aloft view`: every one optional; what is not given comes
-// from the framing camera (the whole mobile in view, a little from the left and above).
+// from the mobile file's "camera" (file_camera.hpp), and what that does not give from the framing camera
+// (the whole mobile in view, a little from the left and above).
 
 #include <cmath>
 #include <numbers>
@@ -10,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "aloft/render/camera.hpp"
+#include "file_camera.hpp"
 
 namespace aloft::cli {
 
@@ -40,6 +42,11 @@ struct CameraFlags {
         ->type_name("X Y Z")
         ->expected(3)
         ->group("Camera");
+  }
+
+  // `framed` with the file's camera, then the given flags, applied.
+  render::OrbitCamera apply(const std::optional<CameraSpec>& file, render::OrbitCamera framed) const {
+    return apply(view::apply_file_camera(file, framed));
   }
 
   // `framed` with the given flags applied.

@@ -65,12 +65,13 @@ MobileSession::MobileSession(const std::string& path, BuildSettings build) : pat
   auto model = compile_with(*spec, build_);
   loaded_time_ = file_time();
   loaded_size_ = file_size();
-  install(std::move(spec), std::move(model), false);
+  install(std::move(spec), std::move(model), false, false);
 }
 
 MobileSession::~MobileSession() {
 #if ALOFT_HAVE_WIND
   wind_.reset();
+  file_winds_.clear();
 #endif
   sim_.reset();
 }
@@ -87,15 +88,23 @@ std::uintmax_t MobileSession::file_size() const {
   return ec ? 0 : s;
 }
 
-void MobileSession::install(std::unique_ptr<MobileSpec> spec, std::unique_ptr<Model> model, bool keep_state) {
+void MobileSession::install(std::unique_ptr<MobileSpec> spec, std::unique_ptr<Model> model, bool keep_state,
+                            bool keep_switches) {
   std::optional<State> kept;
   if (keep_state && sim_ && !failed() && same_pose(*model_, *model)) kept = sim_->state();
 #if ALOFT_HAVE_WIND
   wind_.reset();  // refers to the old model
+  std::vector<FileWind> file_winds_before = std::move(file_winds_);
+  file_winds_.clear();
+  for (FileWind& w : file_winds_before) w.wind.reset();  // so do these
+  if (!keep_switches) file_winds_before.clear();
 #endif
   sim_.reset();
   spec_ = std::move(spec);
   model_ = std::move(model);
+#if ALOFT_HAVE_WIND
+  build_file_winds(file_winds_before);
+#endif
   sim_ = kept ? std::make_unique<Simulation>(*model_, *kept) : std::make_unique<Simulation>(*model_);
   if (!keep_state) damping_ = model_->damping;
   sim_->set_damping(damping_);
@@ -109,10 +118,11 @@ bool MobileSession::load(const std::string& path) {
   try {
     auto spec = std::make_unique<MobileSpec>(parse_mobile_file(path));
     auto model = compile_with(*spec, build_);
+    const bool same_file = path == path_;
     path_ = path;
     loaded_time_ = file_time();
     loaded_size_ = file_size();
-    install(std::move(spec), std::move(model), false);
+    install(std::move(spec), std::move(model), false, same_file);
     error_.clear();
     return true;
   } catch (const std::exception& e) {
@@ -136,7 +146,7 @@ bool MobileSession::rebuild(const BuildSettings& build) {
   try {
     auto model = compile_with(*spec_, build);
     build_ = build;
-    install(std::make_unique<MobileSpec>(*spec_), std::move(model), true);
+    install(std::make_unique<MobileSpec>(*spec_), std::move(model), true, true);
     error_.clear();
     return true;
   } catch (const std::exception& e) {
@@ -162,6 +172,7 @@ void MobileSession::reset() {
   debt_ = 0;
 #if ALOFT_HAVE_WIND
   since_refresh_ = 1e9;
+  for (FileWind& w : file_winds_) w.since_refresh = 1e9;
 #endif
 }
 
@@ -212,6 +223,37 @@ bool MobileSession::update_wind(const Vec3& camera_forward) {
     return false;
   }
 }
+
+void MobileSession::build_file_winds(const std::vector<FileWind>& before) {
+  file_winds_.reserve(spec_->wind_sources.size());
+  for (std::size_t i = 0; i < spec_->wind_sources.size(); ++i) {
+    FileWind w;
+    w.source = spec_->wind_sources[i];
+    w.enabled = file_winds_on_load_;
+    for (const FileWind& old : before)
+      if (old.source.name == w.source.name) w.enabled = old.enabled;  // a reload keeps the switch
+    WindSettings settings = wind_control.settings;
+    settings.alpha = w.source.alpha.value_or(-1);   // air for its own l0 unless the file says
+    settings.beta = w.source.beta.value_or(WindSettings{}.beta);
+    settings.seed = w.source.seed.value_or(wind_control.settings.seed + 1 + i);  // as aloft simulate's default
+    try {
+      w.wind = std::make_unique<Wind>(*model_, WindSource::aimed(w.source.from, w.source.to, w.source.r0, w.source.l0),
+                                      settings);
+    } catch (const std::exception& e) {
+      error_ = "wind source \"" + w.source.name + "\": " + e.what();
+    }
+    file_winds_.push_back(std::move(w));
+  }
+}
+
+void MobileSession::set_file_wind_enabled(std::size_t index, bool on) {
+  if (index < file_winds_.size()) file_winds_[index].enabled = on;
+}
+
+double MobileSession::file_wind_v0(std::size_t index) const {
+  if (index >= file_winds_.size() || !wind_control.enabled || !file_winds_[index].enabled) return 0;
+  return file_winds_[index].source.v0(sim_->state().time);
+}
 #endif
 
 void MobileSession::step_once() {
@@ -227,6 +269,22 @@ void MobileSession::step_once() {
     }
     wind_->apply(sim_->state(), v0(), h, loads);
     since_refresh_ += h;
+    wind_seconds_ += seconds(Clock::now() - t0);
+  }
+  {
+    const auto t0 = Clock::now();
+    for (FileWind& w : file_winds_) {
+      if (!wind_control.enabled || !w.enabled || !w.wind) {
+        w.since_refresh = 1e9;  // switched on again: see the pose of then, not of when it stopped
+        continue;
+      }
+      if (w.since_refresh >= kOcclusionInterval) {
+        w.wind->refresh_occlusion(sim_->state());
+        w.since_refresh = 0;
+      }
+      w.wind->apply(sim_->state(), w.source.v0(sim_->state().time), h, loads);
+      w.since_refresh += h;
+    }
     wind_seconds_ += seconds(Clock::now() - t0);
   }
   gust_level_ *= std::exp(-h / wind_control.gust_time);

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
@@ -51,6 +52,15 @@ struct WindControl {
   double gust_peak = 4.0;             // m/s added by a gust at its start, decaying
   double gust_time = 0.7;             // s, decay time constant of a gust
   WindSettings settings;
+};
+
+// A wind source of the mobile file ("wind_sources": a fan, a vent) as the viewer blows it: its own Wind
+// (cone and occlusion), switched on and off in the panel. The window's wind switch (W) stops it too.
+struct FileWind {
+  WindSourceSpec source;              // as the file says
+  bool enabled = true;
+  std::unique_ptr<Wind> wind;         // null when it could not be built (error() says why)
+  double since_refresh = 1e9;         // simulated s since its last occlusion refresh
 };
 #endif
 
@@ -116,10 +126,21 @@ class MobileSession {
   // Apply wind_control's source and settings (after a slider moved). Returns false with error() set when
   // they are invalid.
   bool update_wind(const Vec3& camera_forward);
+
+  // The file's wind sources, in file order (rebuilt with every new model; a source keeps its on/off
+  // state across a reload of the same file while its name stays). They use wind_control.settings' resolution, tile and
+  // gust time, and the file's alpha, beta and seed where it gives them (else air for its l0, 0.3, and
+  // wind_control.settings.seed + 1 + index, as `aloft simulate` does).
+  const std::vector<FileWind>& file_winds() const { return file_winds_; }
+  void set_file_wind_enabled(std::size_t index, bool on);
+  // Whether a newly loaded file's sources start on (false: `aloft view --no-file-wind`).
+  void set_file_winds_on_load(bool on) { file_winds_on_load_ = on; }
+  double file_wind_v0(std::size_t index) const;       // m/s now (0 when off or the wind is off)
 #endif
 
  private:
-  void install(std::unique_ptr<MobileSpec> spec, std::unique_ptr<Model> model, bool keep_state);
+  // keep_switches: the same file again (a reload or rebuild): its wind sources keep their switches.
+  void install(std::unique_ptr<MobileSpec> spec, std::unique_ptr<Model> model, bool keep_state, bool keep_switches);
   void step_once();
   std::filesystem::file_time_type file_time() const;
   std::uintmax_t file_size() const;
@@ -138,7 +159,10 @@ class MobileSession {
   std::optional<Grab> grab_;
   double physics_seconds_ = 0, wind_seconds_ = 0;
 #if ALOFT_HAVE_WIND
+  void build_file_winds(const std::vector<FileWind>& before);
   std::unique_ptr<Wind> wind_;
+  std::vector<FileWind> file_winds_;   // refer to *model_: cleared before it changes
+  bool file_winds_on_load_ = true;
   double gust_level_ = 0;
   double since_refresh_ = 1e9;         // simulated s since the last occlusion refresh
 #endif

@@ -21,6 +21,7 @@
 #include "aloft/render/gl.hpp"
 #include "aloft/render/image_output.hpp"
 #include "aloft/render/renderer.hpp"
+#include "file_camera.hpp"
 #include "viewer_state.hpp"
 
 namespace aloft::view {
@@ -203,6 +204,7 @@ render::OrbitCamera ViewerState::framed_camera() const {
     const double m_per_px = 2 * c.distance * std::tan(c.fov_y / 2) / std::max(h, 1);
     c.pan(-kPanelWidth / 2 * m_per_px, 0);
   }
+  c = apply_file_camera(session->spec().camera, c);  // the file's camera, then the flags, key by key
   return adjust_camera ? adjust_camera(c) : c;
 }
 
@@ -247,6 +249,10 @@ void ViewerState::toggle_recording() {
 int run_viewer(const ViewerOptions& options) {
   ViewerState v;
   v.session = std::make_unique<MobileSession>(options.file, options.build);  // a bad first file throws here
+#if ALOFT_HAVE_WIND
+  v.session->set_file_winds_on_load(options.file_wind);
+  for (std::size_t i = 0; i < v.session->file_winds().size(); ++i) v.session->set_file_wind_enabled(i, options.file_wind);
+#endif
   v.session->time_scale = options.time_scale;
   v.adjust_camera = options.adjust_camera;
   v.shadows = options.shadows;

@@ -19,13 +19,14 @@ struct ViewerOptions {
   int samples = 4;                       // MSAA samples (0: off)
   bool shadows = true;
   double time_scale = 1.0;
-  // Applied to the framing camera once the mobile is loaded.
+  // Applied to the framing camera after the file's "camera" (the flags: they override the file per key).
   std::function<render::OrbitCamera(render::OrbitCamera)> adjust_camera;
   bool wind = true;                      // the wind module (if built in) on at start
   double breeze = 0;                     // m/s, steady wind at start
   bool show_cone = false;                // the wind cone drawn at start (K toggles it)
   bool show_occlusion = false;           // what the wind reaches drawn at start (O toggles it)
   bool microphone = true;                // open the default capture device (its absence is fine)
+  bool file_wind = true;                 // the mobile file's wind sources on at start (each toggles in the panel)
 
   // Test hooks. frames > 0: run exactly that many frames with a fixed 1/60 s of simulated time per
   // frame (deterministic), save `screenshot` (the scene) and `window_screenshot` (with the panel) of the

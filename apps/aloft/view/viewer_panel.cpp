@@ -3,6 +3,8 @@
 
 #include <imgui.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -38,7 +40,7 @@ void help_window(bool& open) {
       {"R", "reset to rest"},
       {"+ / -", "time scale x2 / /2 (slow motion)"},
       {"G", "a gust of wind"},
-      {"W", "wind on / off"},
+      {"W", "all wind on / off (yours and the file's sources)"},
       {"K / O", "show the wind cone / what the wind reaches"},
       {"S", "shadows on / off"},
       {"C", "reset the camera"},
@@ -81,6 +83,53 @@ void error_banner(MobileSession& session) {
   ImGui::PopStyleColor();
 }
 
+#if ALOFT_HAVE_WIND
+// The cone of `wind`: the S0 circle, a circle at `reach` m from the vertex, and 8 lines along its side.
+render::LineSet cone_lines(const Wind& wind, double reach, const std::array<float, 4>& color) {
+  const WindSource& src = wind.source();
+  const Mat3 frame = wind.frame();
+  const Vec3 right = frame.col(0), up = frame.col(1);
+  render::LineSet cone;
+  cone.color = color;
+  constexpr int kSides = 48;
+  for (double l : {src.l0, reach}) {
+    const double r = src.r0 * l / src.l0;
+    const Vec3 c = src.vertex + l * src.direction;
+    for (int k = 0; k < kSides; ++k) {
+      const double a0 = 2 * std::numbers::pi * k / kSides, a1 = 2 * std::numbers::pi * (k + 1) / kSides;
+      cone.points.push_back(c + r * (std::cos(a0) * right + std::sin(a0) * up));
+      cone.points.push_back(c + r * (std::cos(a1) * right + std::sin(a1) * up));
+    }
+  }
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2 * std::numbers::pi * k / 8;
+    const Vec3 rim = std::cos(a) * right + std::sin(a) * up;
+    cone.points.push_back(src.vertex);
+    cone.points.push_back(src.vertex + reach * src.direction + src.r0 * reach / src.l0 * rim);
+  }
+  return cone;
+}
+
+// Every area element `wind` reaches: a short hair along its normal, facing the wind, and a cross.
+render::LineSet element_lines(const Wind& wind, const State& state, const std::array<float, 4>& color) {
+  render::LineSet hairs;
+  hairs.color = color;
+  const Vec3 d = wind.source().direction;
+  for (const WindElement& e : wind.elements()) {
+    const int c = e.component;
+    if (c < 0 || c >= static_cast<int>(state.position.size())) continue;
+    const Vec3 p = state.position[c] + state.orientation[c] * e.point_body;
+    Vec3 n = state.orientation[c] * e.normal_body;
+    if (n.dot(d) > 0) n = -n;
+    const double size = std::clamp(std::sqrt(e.area), 0.006, 0.05);  // m: about the element's width
+    hairs.points.insert(hairs.points.end(), {p, p + n * size * 1.5});
+    const Vec3 a = n.unitOrthogonal() * size * 0.5, b = n.cross(a);
+    hairs.points.insert(hairs.points.end(), {p - a, p + a, p - b, p + b});
+  }
+  return hairs;
+}
+#endif
+
 }  // namespace
 
 void style_panel() {
@@ -112,49 +161,23 @@ std::vector<render::LineSet> ViewerState::overlay_lines() const {
   }
 #if ALOFT_HAVE_WIND
   const Wind* wind = session->wind();
-  if (wind && session->wind_control.enabled && show_cone) {
-    const WindSource& src = wind->source();
-    const Mat3 frame = wind->frame();
-    const Vec3 right = frame.col(0), up = frame.col(1);
-    render::LineSet cone;
-    cone.color = {0.45f, 0.75f, 1.0f, 0.75f};
-    constexpr int kSides = 48;
-    const double reach = src.l0 + 2 * session->wind_control.distance;  // drawn length of the cone, m
-    for (double l : {src.l0, reach}) {
-      const double r = src.r0 * l / src.l0;
-      const Vec3 c = src.vertex + l * src.direction;
-      for (int k = 0; k < kSides; ++k) {
-        const double a0 = 2 * std::numbers::pi * k / kSides, a1 = 2 * std::numbers::pi * (k + 1) / kSides;
-        cone.points.push_back(c + r * (std::cos(a0) * right + std::sin(a0) * up));
-        cone.points.push_back(c + r * (std::cos(a1) * right + std::sin(a1) * up));
-      }
-    }
-    for (int k = 0; k < 8; ++k) {
-      const double a = 2 * std::numbers::pi * k / 8;
-      const Vec3 rim = std::cos(a) * right + std::sin(a) * up;
-      cone.points.push_back(src.vertex);
-      cone.points.push_back(src.vertex + reach * src.direction + src.r0 * reach / src.l0 * rim);
-    }
-    lines.push_back(std::move(cone));
+  const bool blowing = session->wind_control.enabled;
+  if (wind && blowing && show_cone) {
+    lines.push_back(cone_lines(*wind, wind->source().l0 + 2 * session->wind_control.distance,
+                               {0.45f, 0.75f, 1.0f, 0.75f}));
   }
-  if (wind && session->wind_control.enabled && show_occlusion) {
-    // Every area element the wind reaches: a short hair along its normal, facing the wind, and a cross.
-    render::LineSet hairs;
-    hairs.color = {0.2f, 1.0f, 0.85f, 1.0f};
-    const Vec3 d = wind->source().direction;
-    for (const WindElement& e : wind->elements()) {
-      const int c = e.component;
-      if (c < 0 || c >= static_cast<int>(state.position.size())) continue;
-      const Vec3 p = state.position[c] + state.orientation[c] * e.point_body;
-      Vec3 n = state.orientation[c] * e.normal_body;
-      if (n.dot(d) > 0) n = -n;
-      const double size = std::clamp(std::sqrt(e.area), 0.006, 0.05);  // m: about the element's width
-      hairs.points.insert(hairs.points.end(), {p, p + n * size * 1.5});
-      const Vec3 a = n.unitOrthogonal() * size * 0.5, b = n.cross(a);
-      hairs.points.insert(hairs.points.end(), {p - a, p + a, p - b, p + b});
-    }
-    lines.push_back(std::move(hairs));
+  // The file's sources that blow: warm cones, long enough to pass the whole mobile.
+  for (const FileWind& f : session->file_winds()) {
+    if (!f.wind || !f.enabled || !blowing || !show_cone) continue;
+    const WindSource& src = f.wind->source();
+    double reach = src.l0 + 0.5;  // m from the vertex
+    for (const Vec3& p : state.position) reach = std::max(reach, (p - src.vertex).dot(src.direction) + 0.3);
+    lines.push_back(cone_lines(*f.wind, reach, {1.0f, 0.78f, 0.35f, 0.75f}));
   }
+  if (wind && blowing && show_occlusion) lines.push_back(element_lines(*wind, state, {0.2f, 1.0f, 0.85f, 1.0f}));
+  for (const FileWind& f : session->file_winds())
+    if (f.wind && f.enabled && blowing && show_occlusion)
+      lines.push_back(element_lines(*f.wind, state, {1.0f, 0.9f, 0.3f, 1.0f}));
 #endif
   return lines;
 }
@@ -278,6 +301,19 @@ void ViewerState::draw_panel() {
     ImGui::Checkbox("what it reaches (O)", &show_occlusion);
     ImGui::TextDisabled("ctrl + drag to aim it");
     draw_microphone_controls();
+    const auto& file_winds = session->file_winds();
+    if (!file_winds.empty()) {
+      ImGui::Separator();
+      ImGui::TextUnformatted("In the file (warm cones):");
+      for (std::size_t i = 0; i < file_winds.size(); ++i) {
+        ImGui::PushID(static_cast<int>(i));
+        bool on = file_winds[i].enabled;
+        if (ImGui::Checkbox(file_winds[i].source.name.c_str(), &on)) session->set_file_wind_enabled(i, on);
+        ImGui::SameLine();
+        ImGui::TextDisabled("%.2f m/s", session->file_wind_v0(i));
+        ImGui::PopID();
+      }
+    }
   }
 #endif
 
