@@ -1,6 +1,6 @@
-// The mobile file's "camera" in `aloft render` (no display, EGL): a file camera gives another picture than
-// the framing camera, the camera flags override it key by key, and a bad camera in the file is an error
-// naming the file, line and path.
+// The mobile file's "camera" in `aloft render` (no display, EGL) and `aloft view` (Xvfb): a file camera
+// gives another picture than the framing camera, the camera flags override it key by key, and a bad
+// camera in the file is an error naming the file, line and path.
 
 #include <gtest/gtest.h>
 #include <stb_image.h>
@@ -82,6 +82,27 @@ class FileCamera : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
+  // `aloft view FILE --frames 4` under a virtual X display: its last frame's scene in `out`.
+  int view(const fs::path& file, const std::string& out, const std::string& flags) {
+    const char* asan = std::getenv("ASAN_OPTIONS");
+    const std::string asan_options = std::string(asan ? asan : "") + (asan && *asan ? ":" : "") + "detect_leaks=0";
+    const std::string command = "cd " + quote(dir_.string()) + " && ASAN_OPTIONS=" + quote(asan_options) +
+                                " SDL_AUDIODRIVER=dummy xvfb-run -a -s '-screen 0 1280x720x24' " + quote(ALOFT_CLI) +
+                                " view " + quote(file.string()) +
+                                " --frames 4 --width 320 --height 180 --msaa 0 --no-shadows --no-mic --screenshot " +
+                                out + " " + flags + " > /dev/null 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  // The file's camera as command-line flags.
+  std::string camera_flags() const {
+    const auto& target = camera_.at("target");
+    return "--yaw " + camera_.at("yaw").dump() + " --pitch " + camera_.at("pitch").dump() + " --distance " +
+           camera_.at("distance").dump() + " --fov " + camera_.at("fov").dump() + " --target " + target[0].dump() +
+           " " + target[1].dump() + " " + target[2].dump();
+  }
+
   // `aloft render FILE` of one still with no display (detect_leaks=0 for the child only: Mesa's driver
   // leaks at exit from an unloaded module, see test_viewer_cli.cpp). Returns the exit code.
   int render(const fs::path& file, const std::string& out, const std::string& flags, std::string* output = nullptr) {
@@ -112,10 +133,7 @@ TEST_F(FileCamera, FileCameraIsUsedAndFlagsOverrideItKeyByKey) {
   EXPECT_GT(differing_pixels(file, framed), 192 * 108 / 10);
 
   // The file's camera given as flags on the file without one: the same picture.
-  const auto target = camera_.at("target");
-  const std::string as_flags = "--yaw " + camera_.at("yaw").dump() + " --pitch " + camera_.at("pitch").dump() +
-                               " --distance " + camera_.at("distance").dump() + " --fov " + camera_.at("fov").dump() +
-                               " --target " + target[0].dump() + " " + target[1].dump() + " " + target[2].dump();
+  const std::string as_flags = camera_flags();
   ASSERT_EQ(render(no_camera_, "flags.png", as_flags), 0);
   EXPECT_EQ(differing_pixels(file, load_png(dir_ / "flags.png")), 0);
 
@@ -126,6 +144,18 @@ TEST_F(FileCamera, FileCameraIsUsedAndFlagsOverrideItKeyByKey) {
   const Image file_yaw = load_png(dir_ / "file-yaw.png");
   EXPECT_EQ(differing_pixels(file_yaw, load_png(dir_ / "flags-yaw.png")), 0);
   EXPECT_GT(differing_pixels(file_yaw, file), 192 * 108 / 10);  // and it did turn the camera
+}
+
+// The viewer starts from the file's camera too (the same view as its keys given as flags, another than
+// the framing camera's), and its wind sources blow there as in render (both runs have them).
+TEST_F(FileCamera, ViewerStartsFromTheFileCamera) {
+  ASSERT_EQ(view(fan_room_, "file.png", ""), 0);
+  ASSERT_EQ(view(no_camera_, "flags.png", camera_flags()), 0);
+  ASSERT_EQ(view(no_camera_, "framed.png", ""), 0);
+  const Image file = load_png(dir_ / "file.png");
+  ASSERT_EQ(file.width, 320);
+  EXPECT_EQ(differing_pixels(file, load_png(dir_ / "flags.png")), 0);
+  EXPECT_GT(differing_pixels(file, load_png(dir_ / "framed.png")), 320 * 180 / 10);  // as in render, above
 }
 
 TEST_F(FileCamera, BadCameraInTheFileIsAnError) {
