@@ -7,10 +7,13 @@
 namespace aloft::render::shaders {
 
 // "#version 330 core" or "#version 300 es" + precisions, then `defines` ("#define X\n" lines), then `body`.
-std::string glsl_source(const char* body, bool gles, const std::string& defines = "");
+std::string glsl_source(const std::string& body, bool gles, const std::string& defines = "");
 
+extern const char* const kShadowFunction;   // lit_fraction(); put before the fragment shaders that use it
 extern const char* const kLitVertex;
 extern const char* const kLitFragment;
+extern const char* const kShadowedRoomFragment;
+extern const char* const kCopyFragment;
 extern const char* const kDepthVertex;
 extern const char* const kDepthFragment;
 extern const char* const kLineVertex;

@@ -1,8 +1,9 @@
 #pragma once
 // The gallery renderer: the mobile's components lit and shaded in their colours, on a floor in front of
 // a wall that both receive its soft shadow (a shadow map from a warm spot light, filtered with PCF).
-// Needs a current OpenGL 3.3 core (or ES 3.0) context; draws into whatever framebuffer is bound, which
-// should be multisampled for anti-aliasing (see FrameTarget).
+// Needs a current OpenGL 3.3 core (or ES 3.0) context. Draws into a FrameTarget (fast: the room is shaded
+// once and reused while the camera rests; anti-aliasing only where the mobile is) or into whatever
+// framebuffer is bound (everything shaded every time).
 
 #include <array>
 #include <memory>
@@ -10,6 +11,7 @@
 
 #include "aloft/model.hpp"
 #include "aloft/render/camera.hpp"
+#include "aloft/render/frame_target.hpp"
 #include "aloft/render/scene_mesh.hpp"
 #include "aloft/state.hpp"
 
@@ -21,6 +23,10 @@ struct DrawOptions {
   bool mobile = true;             // false: the empty room (tests compare against it)
   int highlighted = -1;           // component drawn with a warm glow (the grabbed one), -1: none
   int shadow_map_size = 1024;     // texels per side (the light's frustum is fitted to the mobile)
+  // Into a FrameTarget: keep the room shaded in its cached background while the camera, size and model
+  // stay the same, and anti-alias only the mobile's rectangle. false: shade the whole picture anew
+  // every frame (through the whole multisampled buffer), as the reference the fast path is tested against.
+  bool reuse_background = true;
 };
 
 // Line segments drawn over the scene (depth-tested): the wind cone, the grab spring.
@@ -56,8 +62,15 @@ class Renderer {
   const SceneMesh& scene() const;
   const Room& room() const;
 
-  // Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport.
+  // Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport. When that
+  // framebuffer is a FrameTarget's of this size (FrameTarget::bind()), the same as draw(..., target, ...).
   void draw(const State& state, const OrbitCamera& camera, int width, int height, const DrawOptions& options,
+            const std::vector<LineSet>& lines = {});
+  // Draw the scene into `target` (call target.resolve() before reading it). Fast path: the background
+  // (the room, lit and in full shadow) is shaded only when the camera, the size or the model changed;
+  // each frame copies it, blends in the shadow inside the rectangle where it can fall, and draws the
+  // mobile and the lines — through the multisampled buffer over their screen rectangle only.
+  void draw(const State& state, const OrbitCamera& camera, FrameTarget& target, const DrawOptions& options,
             const std::vector<LineSet>& lines = {});
 
  private:

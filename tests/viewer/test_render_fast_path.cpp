@@ -1,0 +1,203 @@
+// The renderer's fast path (a FrameTarget: the room shaded once and reused, the shadow blended from the
+// cached lit and unlit room, anti-aliasing only over the mobile's rectangles) against the reference
+// (everything shaded anew through the whole multisampled buffer), and what anti-aliasing does to a
+// thin wire. Drawn in-process on Mesa's llvmpipe through EGL (no display needed).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
+
+#include "aloft/model.hpp"
+#include "aloft/render/frame_target.hpp"
+#include "aloft/render/headless_context.hpp"
+#include "aloft/render/renderer.hpp"
+#include "aloft/simulation.hpp"
+#include "support/model_builder.hpp"
+#include "support/presets.hpp"
+
+namespace aloft::render {
+namespace {
+
+constexpr int kWidth = 640, kHeight = 360;  // small: the tests stay fast on a software rasteriser
+
+using Pixels = std::vector<std::uint8_t>;
+
+Pixels draw(Renderer& renderer, FrameTarget& target, const State& state, const OrbitCamera& camera,
+            const DrawOptions& options) {
+  target.bind();
+  renderer.draw(state, camera, kWidth, kHeight, options);
+  target.resolve();
+  Pixels pixels;
+  target.read_rgba(pixels);
+  return pixels;
+}
+
+struct Difference {
+  int largest = 0;        // over every channel of every pixel, 8-bit levels
+  double beyond = 0;      // fraction of pixels with some channel more than `tolerance` apart
+};
+
+Difference compare(const Pixels& a, const Pixels& b, int tolerance) {
+  Difference d;
+  long long count = 0;
+  for (std::size_t p = 0; p + 3 < a.size(); p += 4) {
+    int worst = 0;
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(a[p + c]) - int(b[p + c])));
+    d.largest = std::max(d.largest, worst);
+    if (worst > tolerance) ++count;
+  }
+  d.beyond = static_cast<double>(count) / (static_cast<double>(a.size()) / 4);
+  return d;
+}
+
+// The Steel Fish a moment after being pushed, so pieces are turned and their shadows spread over floor
+// and wall.
+State pushed_fish(const Model& model) {
+  State start = rest_state(model);
+  for (std::size_t i = 1; i < start.angular.size(); ++i) start.angular[i] = Vec3(0.3, 1.5 * (i % 3), 0.2);  // rad/s
+  Simulation sim(model, start);
+  for (int k = 0; k < 400 && sim.step(); ++k) {
+  }
+  return sim.state();
+}
+
+// See SamePictureAsShadingEverythingAnew for the tolerances.
+void expect_same_picture(const Pixels& fast, const Pixels& reference) {
+  const Difference d = compare(fast, reference, 3);
+  EXPECT_LT(d.beyond, 5e-5);
+  EXPECT_LT(d.largest, 24);
+}
+
+class RenderFastPath : public ::testing::Test {
+ protected:
+  HeadlessContext context;
+};
+
+TEST_F(RenderFastPath, SamePictureAsShadingEverythingAnew) {
+  const Model model = load_mobile(test::preset_path("steel-fish"));
+  Renderer renderer;
+  renderer.set_model(model);
+  const State state = pushed_fish(model);
+  const OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
+  FrameTarget target;
+  target.resize(kWidth, kHeight, 4);
+  DrawOptions fast, reference;
+  reference.reuse_background = false;
+
+  const Pixels first = draw(renderer, target, state, camera, fast);
+  const Pixels again = draw(renderer, target, state, camera, fast);   // from the cached background
+  const Pixels full = draw(renderer, target, state, camera, reference);
+  // The picture must show something besides the room: the mobile and its shadow differ from the room.
+  DrawOptions empty_room = reference;
+  empty_room.mobile = false;
+  const Pixels room = draw(renderer, target, state, camera, empty_room);
+  EXPECT_GT(compare(full, room, 24).beyond, 0.01);
+
+  // The cache changes nothing: the second frame is the first, bit for bit.
+  EXPECT_EQ(compare(first, again, 0).largest, 0);
+
+  // Against the reference: the shadow is the cached lit and unlit room blended in linear colour, so a
+  // room pixel differs by the 8-bit rounding of the two cached pictures carried through the blend (at
+  // most 2 levels; 3 allows for the final rounding). Beyond that only a handful of pixels where a
+  // multisampled edge meets a shadow's edge (the fast path blends the resolved pixel where the
+  // reference shades each sample): under 5e-5 of the picture (11 pixels; 2 seen). A missed patch of
+  // shadow is off by the shadow's full contrast (~65 levels) over tens of pixels (one rectangle
+  // dropped: 46 pixels, 2e-4), so the largest difference must also stay under that: 24 levels, a bit
+  // over a third of the contrast, the most an edge pixel shared with a shadow's edge shows.
+  expect_same_picture(again, full);
+}
+
+TEST_F(RenderFastPath, CacheFollowsTheCamera) {
+  const Model model = load_mobile(test::preset_path("steel-fish"));
+  Renderer renderer;
+  renderer.set_model(model);
+  const State state = pushed_fish(model);
+  OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
+  FrameTarget target;
+  target.resize(kWidth, kHeight, 4);
+  DrawOptions fast, reference;
+  reference.reuse_background = false;
+
+  const Pixels before = draw(renderer, target, state, camera, fast);
+  camera.orbit(0.3, 0.1);
+  // While the camera moves the background is redrawn without anti-aliasing; the first frame with the
+  // camera at rest draws it again with anti-aliasing, and then it matches the reference (as above).
+  const Pixels moving = draw(renderer, target, state, camera, fast);
+  const Pixels rested = draw(renderer, target, state, camera, fast);
+  const Pixels full = draw(renderer, target, state, camera, reference);
+  EXPECT_GT(compare(before, rested, 24).beyond, 0.05);   // the view did change (the room moved)
+  // Moving: the floor-wall line aliased (a pixel or two per column, under 1 % of the picture; 0.2 %
+  // seen), no stale room (that would be most of the picture, as `before` against `rested` shows).
+  EXPECT_LT(compare(moving, full, 3).beyond, 0.01);
+  expect_same_picture(rested, full);
+}
+
+// A thin dark wire, slanted, in front of the wall: with anti-aliasing its edge pixels take colours
+// between the wire's and the wall's (partial coverage), which the aliased picture lacks; the wire's
+// total darkening (its coverage summed over the picture) stays about the same.
+TEST_F(RenderFastPath, AntiAliasingGivesAWireIntermediateColours) {
+  Model model = test::empty_model(2);
+  model.rest_position[0] = Vec3(0, 2.0, 0);
+  BodyShape hook, wire;
+  hook.shape = Sphere{Vec3::Zero(), 0.01};
+  model.shapes[0].push_back(hook);
+  model.parent[1] = 0;
+  model.rest_position[1] = Vec3(0, 1.7, 0);
+  model.joint_world[1] = Vec3(0, 2.0, 0);
+  // 0.6 mm radius: drawn at the minimum of 1.2 mm, under a pixel wide at this distance.
+  wire.shape = Wire{Vec3(-0.5, -0.15, 0), Vec3(0.5, 0.15, 0), 0.0006};
+  model.shapes[1].push_back(wire);
+  model.color = {Color{0.1f, 0.1f, 0.1f}, Color{0.05f, 0.05f, 0.05f}};
+  test::finish_model(model);
+  const State state = rest_state(model);
+
+  Renderer renderer;
+  renderer.set_model(model);
+  const OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
+  DrawOptions options;
+  options.shadows = false;  // only the wire against the room
+  DrawOptions empty = options;
+  empty.mobile = false;
+
+  const auto luminance = [](const Pixels& p, std::size_t i) { return (p[i] + p[i + 1] + p[i + 2]) / 3.0; };
+  struct Coverage {
+    int intermediate = 0;   // pixels between 20 % and 80 % darkened towards the wire
+    double total = 0;       // the darkening summed, pixels' worth
+  };
+  const auto coverage = [&](int samples) {
+    FrameTarget target;
+    target.resize(kWidth, kHeight, samples);
+    const Pixels room = draw(renderer, target, state, camera, empty);
+    const Pixels wire = draw(renderer, target, state, camera, options);
+    Coverage c;
+    for (std::size_t i = 0; i + 3 < wire.size(); i += 4) {
+      const double background = luminance(room, i);
+      const double darkening = background - luminance(wire, i);
+      if (darkening < 2) continue;  // untouched (2 levels: rounding)
+      // The wire's own colour is ~20 levels (0.05 lit and encoded); the fraction of the way there.
+      const double f = std::clamp(darkening / (background - 20.0), 0.0, 1.0);
+      c.total += f;
+      if (f > 0.2 && f < 0.8) ++c.intermediate;
+    }
+    return c;
+  };
+  const Coverage aliased = coverage(0);
+  const Coverage smooth = coverage(4);
+  ASSERT_GT(aliased.total, 100) << "the wire must be on the picture";
+  // The wire darkens ~400 pixels' worth. Anti-aliased, a sub-pixel line has an edge pixel or two of
+  // partial coverage in every column it crosses (over 200 columns here), so hundreds of intermediate
+  // pixels (600 seen); aliased, a pixel is hit or missed, and intermediate values come only from the
+  // wire's own shading (90 seen): at least 3 times more with anti-aliasing.
+  EXPECT_GT(smooth.intermediate, 200);
+  EXPECT_GT(smooth.intermediate, 3 * std::max(aliased.intermediate, 1));
+  // Coverage is conserved up to sampling: 4 samples against 1 per pixel over ~400 pixels' worth of wire
+  // differ by a few per cent (4 % seen); 15 % bounds it.
+  EXPECT_NEAR(smooth.total, aliased.total, 0.15 * aliased.total);
+}
+
+}  // namespace
+}  // namespace aloft::render
