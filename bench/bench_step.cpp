@@ -103,6 +103,14 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions) {
   const double elapsed = cpu_seconds() - start;
   benchmark::DoNotOptimize(sim.state().position.data());
   set_counters(state, model, elapsed);
+  // How often a step was halved (step-size rule or unconverged joints) and the tree solves per step
+  // (Newton corrections plus one velocity projection per (sub)step), as in aloft_step_profile.
+  const double steps = static_cast<double>(state.iterations());
+  if (steps > 0) {
+    const double halvings = static_cast<double>(sim.subdivisions());
+    state.counters["halvings"] = halvings / steps;
+    state.counters["solves"] = (static_cast<double>(sim.joint_iterations()) + steps + halvings) / steps;
+  }
 }
 
 void BM_Factor(benchmark::State& state, const std::string& key) {
