@@ -67,6 +67,8 @@ class CollisionDetector {
   CollisionDetector& operator=(CollisionDetector&&) noexcept;
 
   const CollisionPairs& pairs() const;
+  // Largest distance (m) from component i's centre of mass to its surface; 0 for one without shapes.
+  double reach(int component) const;
 
   // Contacts of `state` whose signed distance is below
   //     base_margin + step * (speed bound of a + speed bound of b),

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <variant>
 
 #include "aloft/geometry.hpp"
@@ -65,8 +66,42 @@ void add_plate(int shape, const Plate& plate, std::vector<ConvexPiece>& out) {
       vertices.push_back(p - half);
       vertices.push_back(p + half);
     }
-    out.push_back(polytope(shape, std::move(vertices)));
+    ConvexPiece piece = polytope(shape, std::move(vertices));
+    // Face normals of the prism: its two caps (the plate's normal) and one per side.
+    piece.axes.push_back(plate.normal());
+    for (std::size_t k = 0; k < part.size(); ++k) {
+      const Vec3 edge = plate.to_world(plate.points[part[(k + 1) % part.size()]]) - plate.to_world(plate.points[part[k]]);
+      const Vec3 side = edge.cross(plate.normal());
+      if (side.norm() > 0) piece.axes.push_back(side.normalized());
+    }
+    out.push_back(std::move(piece));
   }
+}
+
+// The face normals of the tetrahedron (a, b, c, apex): the triangle's and those of its three sides
+// through `apex`.
+std::vector<Vec3> triangle_solid_axes(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& apex) {
+  std::vector<Vec3> axes;
+  const Vec3 n = (b - a).cross(c - a);
+  if (n.norm() > 0) axes.push_back(n.normalized());
+  for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+    const Vec3 side = (q - p).cross(apex - p);
+    if (side.norm() > 0) axes.push_back(side.normalized());
+  }
+  return axes;
+}
+
+// The face normals of the triangle (a, b, c) extruded by `offset`: its caps and its three sides (each
+// containing an edge and the offset).
+std::vector<Vec3> prism_axes(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& offset) {
+  std::vector<Vec3> axes;
+  const Vec3 n = (b - a).cross(c - a);
+  if (n.norm() > 0) axes.push_back(n.normalized());
+  for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+    const Vec3 side = (q - p).cross(offset);
+    if (side.norm() > 0) axes.push_back(side.normalized());
+  }
+  return axes;
 }
 
 void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out) {
@@ -88,9 +123,11 @@ void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     if (star) {
       out.push_back(polytope(shape, {a, b, c, centroid}));
+      out.back().axes = triangle_solid_axes(a, b, c, centroid);
     } else {
       const Vec3 inward = -kShellThickness * (b - a).cross(c - a).normalized();
       out.push_back(polytope(shape, {a, b, c, a + inward, b + inward, c + inward}));
+      out.back().axes = prism_axes(a, b, c, inward);
     }
   }
 }
@@ -173,6 +210,7 @@ ComponentGeometry build_component_geometry(const std::vector<BodyShape>& shapes)
                      p.a = w.from;
                      p.b = w.to;
                      p.radius = w.radius;
+                     if ((w.to - w.from).norm() > 0) p.axes.push_back((w.to - w.from).normalized());
                      g.pieces.push_back(p);
                    },
                    [&](const Box& b) {
@@ -182,6 +220,7 @@ ComponentGeometry build_component_geometry(const std::vector<BodyShape>& shapes)
                        corners.push_back(b.center + b.rotation * (0.5 * b.size.cwiseProduct(sign)));
                      }
                      g.pieces.push_back(polytope(k, std::move(corners)));
+                     for (int axis = 0; axis < 3; ++axis) g.pieces.back().axes.push_back(b.rotation.col(axis));
                    },
                    [&](const Plate& p) { add_plate(k, p, g.pieces); },
                    [&](const Mesh& m) { add_mesh(k, m.mesh, g.pieces); },

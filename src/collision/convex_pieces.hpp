@@ -30,6 +30,9 @@ struct ConvexPiece {
   Vec3 b = Vec3::Zero();           // cylinder: other end of the axis (body frame, m)
   double radius = 0;               // sphere, cylinder: m
   std::vector<Vec3> vertices;      // polytope: the piece is their convex hull (body frame, m)
+  // Directions worth testing as a separating axis (body frame, unit, sign irrelevant): a polytope's face
+  // normals, a cylinder's axis. The overlap test checks them besides EPA's answer (gjk_contact.cpp).
+  std::vector<Vec3> axes;
   Vec3 bound_center = Vec3::Zero();  // a sphere enclosing the piece (body frame, m)
   double bound_radius = 0;
 

@@ -112,6 +112,8 @@ CollisionDetector& CollisionDetector::operator=(CollisionDetector&&) noexcept = 
 
 const CollisionPairs& CollisionDetector::pairs() const { return impl_->pairs; }
 
+double CollisionDetector::reach(int component) const { return impl_->geometry[component].reach; }
+
 void CollisionDetector::find_contacts(const State& state, double step, double base_margin,
                                       std::vector<Contact>& contacts) {
   Impl& d = *impl_;

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -235,6 +237,66 @@ TEST(NarrowPhase, BoxAndMeshPieces) {
   ASSERT_TRUE(m);
   EXPECT_NEAR(m->distance, 0.1, 1e-12);
   EXPECT_EQ(pieces_of(mesh).size(), mesh.mesh.triangles.size());
+}
+
+
+TEST(NarrowPhase, SmallOverlapsAreReportedSmall) {
+  // Pieces that touch and then overlap by delta along their separating normal: the true penetration depth
+  // is at most delta (moving back by delta separates them). EPA alone has answered such touches with
+  // overlaps of centimetres in another direction (in the Steel Fish, a 0.01 mm touch of two wires came
+  // out as 9.7 mm the other way), and the overlap correction then pushed one piece through the other.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  auto random_direction = [&] { return Vec3(u(rng), u(rng), u(rng)).normalized(); };
+  int checked = 0, missed = 0;
+  double worst_excess = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Vec3 axis = random_direction();
+    const Wire wire{-0.1 * axis, (0.05 + 0.2 * unit(rng)) * axis, 0.0005 + 0.0025 * unit(rng)};
+    Shape other;
+    if (trial % 2 == 0) {
+      const Vec3 centre = 0.1 * random_direction();
+      const Vec3 along = random_direction();
+      other = Wire{centre, centre + (0.05 + 0.2 * unit(rng)) * along, 0.0005 + 0.0025 * unit(rng)};
+    } else {
+      Plate plate = square_plate(0.03 + 0.05 * unit(rng), 0.0015);
+      plate.u_axis = random_direction();
+      plate.v_axis = plate.u_axis.cross(random_direction()).normalized();
+      plate.origin = 0.1 * random_direction();
+      other = plate;
+    }
+    const Pose identity;
+    for (const ConvexPiece& x : pieces_of(wire)) {
+      for (const ConvexPiece& y : pieces_of(other)) {
+        PieceContact apart;
+        if (!piece_contact(x, identity, y, identity, 10.0, apart) || !(apart.distance > 1e-4)) continue;
+        const double delta = std::pow(10.0, -5 + 2 * unit(rng));  // 0.01 mm .. 1 mm
+        Pose moved;
+        moved.position = (apart.distance + delta) * apart.normal;  // b towards a: overlap delta along n
+        PieceContact touching;
+        if (!piece_contact(x, identity, y, moved, 1e-4, touching)) {
+          ++missed;  // libccd's GJK found no overlap (see gjk_contact.cpp): counted, bounded below
+          continue;
+        }
+        // Conservative (the reported gap is the gap along one direction, so <= the signed distance) and
+        // not much deeper than delta. The direction found (EPA's, a face normal or the cores') is off the
+        // best one on round supports, and EPA stops short there by 1e-5..1e-4 m (libccd); measured here:
+        // up to 0.2 mm too deep for touches of 0.01-0.06 mm, a few per cent for deeper ones. So 10 % +
+        // 0.25 mm: the failures this guards against were centimetres (a hundred times more).
+        worst_excess = std::max(worst_excess, -touching.distance - delta);
+        EXPECT_LE(-touching.distance, 1.1 * delta + 2.5e-4) << "trial " << trial << " delta " << delta;
+        EXPECT_GE(-touching.distance, -1e-7) << "trial " << trial;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+  // A touch libccd does not see as an overlap gives no contact at all (the speculative contact of the
+  // step before, while the pieces were apart, is what keeps them from passing: measured in
+  // tests/dynamics/test_collisions.cpp). Such misses must stay rare: under 5 % of these touches.
+  EXPECT_LT(missed, checked / 20);
+  std::printf("small overlaps: %d checked, %d missed, reported at most %.3g mm deeper than the overlap made\n",
+              checked, missed, worst_excess * 1e3);
 }
 
 }  // namespace
