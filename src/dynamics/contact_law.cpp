@@ -14,8 +14,31 @@ constexpr int kMaxSweeps = 200;
 // A slip speed (m/s) below this has no reliable direction; the sticking impulse's direction is used.
 constexpr double kSlipDirectionFloor = 1e-9;
 
+// A contact block whose smallest eigenvalue is below this fraction of its largest is treated as singular
+// (rank-deficient): e.g. two bodies whose relative motion at the point is confined to a plane. 1e-12 is
+// ~1e4 times double rounding of the block's entries, far below any physical stiffness ratio.
+constexpr double kSingularBlock = 1e-12;
+
 using Vec3d = Eigen::Vector3d;
 using Mat3d = Eigen::Matrix3d;
+
+// The impulse that changes the contact velocity by `change` through the (symmetric, positive
+// semi-definite) block K: K^-1 change, or, when K is singular, the least-squares impulse of least norm
+// (K's pseudo-inverse): the part of `change` no impulse can produce is left out instead of being bought
+// with an unbounded impulse.
+Vec3d block_solve(const Mat3d& K, const Vec3d& change) {
+  const Eigen::LDLT<Mat3d> ldlt(K);
+  const Vec3d pivots = ldlt.vectorD().cwiseAbs();
+  if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff())
+    return ldlt.solve(change);
+  Eigen::SelfAdjointEigenSolver<Mat3d> eigen;
+  eigen.computeDirect(K);
+  const Vec3d values = eigen.eigenvalues();
+  const double cutoff = kSingularBlock * values.cwiseAbs().maxCoeff();
+  Vec3d in_eigenbasis = eigen.eigenvectors().transpose() * change;
+  for (int k = 0; k < 3; ++k) in_eigenbasis[k] = values[k] > cutoff ? in_eigenbasis[k] / values[k] : 0.0;
+  return eigen.eigenvectors() * in_eigenbasis;
+}
 
 // The impulse of one contact (in its basis) given the velocity it would have without its own impulse.
 Vec3d contact_impulse(const Mat3d& K, const Vec3d& u_free, const ContactLawRow& row, bool* sliding) {
@@ -26,7 +49,7 @@ Vec3d contact_impulse(const Mat3d& K, const Vec3d& u_free, const ContactLawRow& 
 
   // Mirtich's prediction: the impulse that makes the contact stick (normal target met, no slip).
   const Vec3d wanted(row.target_normal, 0, 0);
-  const Vec3d stick = K.ldlt().solve(wanted - u_free);
+  const Vec3d stick = block_solve(K, wanted - u_free);
   const double tangential = stick.tail<2>().norm();
   if (std::isfinite(tangential) && stick.x() > 0 && tangential <= row.friction * stick.x()) return stick;
 

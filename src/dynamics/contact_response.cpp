@@ -115,22 +115,28 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     report.deepest = std::max(report.deepest, -c.distance);
   }
 
-  // The collision matrix, one column per unit impulse along a contact's basis vector.
+  // The collision matrix K = G H^-1 G^T from path-sparse columns: each contact's three unit impulses
+  // (along its basis) eliminated only along the paths from its two bodies to the base, and every 3x3 block
+  // summed over the nodes two contacts' paths share. O(m depth) for the columns and O(m^2 depth) for the
+  // blocks, instead of 3m full O(n) tree solves.
+  if (static_cast<int>(columns_.size()) < m) columns_.resize(m);
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = contacts[k];
+    Mat63 on_a, on_b;
+    on_a.topRows<3>() = basis_[k];
+    on_a.bottomRows<3>() = skew(arm_a_[k]) * basis_[k];
+    on_b.topRows<3>() = -basis_[k];
+    on_b.bottomRows<3>() = -skew(arm_b_[k]) * basis_[k];
+    solver.eliminate_on_paths(c.a, on_a, c.b, on_b, columns_[k]);
+  }
   K_.resize(3 * m, 3 * m);
-  Eigen::VectorXd unit = Eigen::VectorXd::Zero(3 * m);
-  for (int col = 0; col < 3 * m; ++col) {
-    unit[col] = 1;
-    respond(contacts, unit, false);
-    unit[col] = 0;
-    for (int k = 0; k < m; ++k) {
-      const Contact& c = contacts[k];
-      auto moved = [&](int body, const Vec3& arm) -> Vec3 {
-        return body == 0 ? Vec3::Zero() : Vec3(du_[body].head<3>() + du_[body].tail<3>().cross(arm));
-      };
-      K_.block<3, 1>(3 * k, col) = basis_[k].transpose() * (moved(c.a, arm_a_[k]) - moved(c.b, arm_b_[k]));
+  for (int k = 0; k < m; ++k) {
+    for (int l = k; l < m; ++l) {
+      const Mat3 block = TreeSolver::coupling(columns_[k], columns_[l]);
+      K_.block<3, 3>(3 * k, 3 * l) = block;
+      K_.block<3, 3>(3 * l, 3 * k) = block.transpose();
     }
   }
-  K_ = (0.5 * (K_ + K_.transpose())).eval();  // symmetric up to round-off; make it exactly so
 
   // Targets: bounce what collides fast within this step; let the rest close their gap but not pass it.
   const double threshold = std::max(tuning.bounce_threshold, 2.0 * model_.gravity.norm() * h);

@@ -6,8 +6,9 @@
 // the contact impulses P and the joint impulses; the equations are momentum for every component, the
 // joints' velocity constraints, and the contact law. That is the velocity-level tree system of section
 // 3 with the contact rows as auxiliary rows. Its Schur complement on the contact rows is the collision
-// matrix K = G H^-1 G^T (3 rows per contact), whose columns are tree solves with unit contact impulses:
-// 3m solves of O(n) each for m contacts. The contact law (dynamics/contact_law.hpp) then gives P, and
+// matrix K = G H^-1 G^T (3 rows per contact). It is built from the tree factorization's path-sparse
+// columns (TreeSolver::eliminate_on_paths): a unit impulse at a contact touches only the nodes on the
+// paths from its two bodies to the base, so K costs O(m^2 depth) for m contacts, not m full solves. The contact law (dynamics/contact_law.hpp) then gives P, and
 // one more tree solve with G^T P gives every component's velocity change and the joint impulses — so
 // one knock moves the whole chain the way a real mobile does.
 //
@@ -74,7 +75,8 @@ class ContactResponse {
   // beyond `tolerance` (m/s of normal velocity).
   bool correct(double h, std::vector<Vec3>& velocity, std::vector<Vec3>& angular, double tolerance);
 
-  // The most contacts solved in one step (the collision matrix is 3m x 3m and costs 3m tree solves).
+  // The most contacts solved in one step (the collision matrix is 3m x 3m; the contact law's sweeps cost
+  // O(m^2) each).
   static constexpr int kMaxContacts = 128;
   // The contacts the last resolve() solved, in the order of the matrices below.
   const std::vector<Contact>& kept() const { return kept_; }
@@ -102,6 +104,7 @@ class ContactResponse {
   std::vector<Mat3> basis_;
   std::vector<Vec3> arm_a_, arm_b_;  // centre of mass of a (b) -> contact point, world, m
   std::vector<ContactLawRow> rows_;
+  std::vector<PathColumns> columns_;  // per contact, reused (no allocation once grown)
   Eigen::MatrixXd K_;
   Eigen::VectorXd u_, P_;
   std::vector<Vec6> wrench_;   // per body, zero between uses

@@ -1,6 +1,7 @@
 #include "dynamics/tree_solver.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 
 namespace aloft {
 
@@ -193,6 +194,73 @@ void TreeSolver::solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3
     u[i] = y_[i] + w_[i] * lam;
     if (lambda) (*lambda)[i] = lam;
   }
+}
+
+void TreeSolver::eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_b, const Mat63& wrench_b,
+                                    PathColumns& out) const {
+  const std::vector<int>& parent = model_.parent;
+  out.clear();
+  // Walk both paths to the base together, always taking the larger index (children have larger indices
+  // than their parents, so every node is reached after all of its path-children). `pending_*` is the wrench
+  // carried to the next node of each path.
+  int x = body_a, z = body_b;
+  Mat63 pending_x = wrench_a, pending_z = wrench_b;
+  while (x > 0 || z > 0) {
+    const int i = std::max(x, z);
+    Mat63 g = Mat63::Zero();
+    if (x == i) g += pending_x;
+    if (z == i) g += pending_z;
+    // y = D_i^-1 g (see the factored form in the header).
+    Mat63 y;
+    if (leaf_[i]) {
+      y.topRows<3>() = inverse_mass_[i] * g.topRows<3>();
+      y.bottomRows<3>() = inverse_inertia_[i] * g.bottomRows<3>();
+    } else {
+      const Mat3 y2 = s_inv_[i] * (g.bottomRows<3>() - t_[i].transpose() * g.topRows<3>());
+      y.topRows<3>() = a_inv_[i] * g.topRows<3>() - t_[i] * y2;
+      y.bottomRows<3>() = y2;
+    }
+    // Joint node: j = c - J_ii y with c = 0, i.e. minus the joint point's velocity v + w x r.
+    const Mat3 j = skew_times(child_arm_[i], y.bottomRows<3>()) - y.topRows<3>();
+    const Mat3 a = k_inv_[i] * j;
+    out.node.push_back(i);
+    out.g.push_back(g);
+    out.y.push_back(y);
+    out.j.push_back(j);
+    out.a.push_back(a);
+    // Eliminating joint i adds J_ip^T a = [-a; -[s_i]x a] to the parent's entry.
+    const int p = parent[i];
+    Mat63 carried;
+    carried.topRows<3>() = -a;
+    carried.bottomRows<3>() = -skew_times(parent_arm_[i], a);
+    const bool merged = x == i && z == i;  // both paths passed through i: carry the sum once, on x
+    if (x == i) {
+      x = p;
+      pending_x = carried;
+    }
+    if (z == i) {
+      z = p;
+      pending_z = merged ? Mat63::Zero() : carried;
+    }
+  }
+}
+
+Mat3 TreeSolver::coupling(const PathColumns& x, const PathColumns& y) {
+  Mat3 out = Mat3::Zero();
+  std::size_t p = 0, q = 0;
+  while (p < x.node.size() && q < y.node.size()) {
+    if (x.node[p] > y.node[q]) {
+      ++p;
+    } else if (x.node[p] < y.node[q]) {
+      ++q;
+    } else {
+      out.noalias() += x.g[p].transpose() * y.y[q];
+      out.noalias() -= x.j[p].transpose() * y.a[q];
+      ++p;
+      ++q;
+    }
+  }
+  return out;
 }
 
 Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state) {

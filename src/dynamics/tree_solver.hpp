@@ -30,6 +30,21 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat63 = Eigen::Matrix<double, 6, 3>;
 
+// The non-zero part of L^-1 [F; 0] for three wrench columns F applied at one or two bodies, where
+// H = L D L^T is TreeSolver's factorization: only the body and joint nodes on the paths from those bodies
+// to the base are non-zero (eliminating a node touches only its parent). Entries are stored per node,
+// nodes in decreasing index order (tip to base). Because H^-1 = L^-T D^-1 L^-1,
+//     F1^T H^-1 F2 = sum over nodes on both paths of  g1^T D_i^-1 g2  -  j1^T K_i^-1 j2
+// (the joint nodes' pivots are -K_i), which TreeSolver::coupling() evaluates in O(common path length).
+struct PathColumns {
+  std::vector<int> node;        // body (and its parent joint) indices, decreasing
+  std::vector<Mat63> g;         // body-node entries: the wrench gathered at the body (N s, N m s), world
+  std::vector<Mat63> y;         // D_i^-1 g: the body's velocity change with its parent joint held (m/s, rad/s)
+  std::vector<Mat3> a;          // K_i^-1 j, j = -J_ii y the joint-node entries (joint impulse, N s)
+  std::vector<Mat3> j;          // joint-node entries: minus the joint point's velocity change (m/s)
+  void clear() { node.clear(); g.clear(); y.clear(); a.clear(); j.clear(); }
+};
+
 class TreeSolver {
  public:
   explicit TreeSolver(const Model& model);
@@ -50,6 +65,16 @@ class TreeSolver {
              std::vector<Vec3>* lambda = nullptr);
   // The same with f = 0 (joint rows only), which saves the leaves' work.
   void solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda = nullptr);
+
+  // Eliminate three wrench columns (world; rows force then torque) applied at `body_a` (wrench_a) and
+  // `body_b` (wrench_b) along the paths to the base, with the last factorization. Either body may be 0
+  // (the fixed component: its wrench is ignored) and they may be equal. O(path lengths), no allocation once
+  // `out` has grown to the tree's depth.
+  void eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_b, const Mat63& wrench_b,
+                          PathColumns& out) const;
+  // F1^T H^-1 F2 (the 3x3 block of velocity responses) for two eliminated column sets: column j of x's
+  // wrenches against column i of y's gives entry (j, i). Symmetric: coupling(y, x) = coupling(x, y)^T.
+  static Mat3 coupling(const PathColumns& x, const PathColumns& y);
 
   // World lever arms at the factored pose: centre of mass of body i -> joint i, and of parent -> joint i.
   const std::vector<Vec3>& child_arm() const { return child_arm_; }

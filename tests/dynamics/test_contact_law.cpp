@@ -221,5 +221,39 @@ TEST(ContactLaw, SimultaneousContactsSatisfyTheLawTogether) {
   }
 }
 
+
+TEST(ContactLaw, SingularBlockGivesAFiniteImpulseThatMeetsTheNormalTarget) {
+  // A point on a body that can only turn about a pivot (a child against its own parent's joint, or a
+  // body on a nail): its velocity w x r is always perpendicular to the arm r, so K = -[r]x I^-1 [r]x has
+  // rank 2. With the arm along the second tangent, no impulse can change that component of the slip:
+  // the law must leave it (pseudo-inverse) instead of answering with an unbounded impulse.
+  std::mt19937 rng(21);
+  for (int trial = 0; trial < 50; ++trial) {
+    FreeBody body = random_body(rng);
+    const Mat3 B = basis_of(Vec3::UnitY());
+    const Vec3 arm = 0.2 * B.col(2);
+    const Mat3 inverse = body.inertia.inverse();
+    Eigen::MatrixXd K(3, 3);
+    K = B.transpose() * (-skew(arm) * inverse * skew(arm)) * B;
+    const Vec3 w = body.w;
+    Eigen::VectorXd u = B.transpose() * w.cross(arm);
+    u[0] = -std::abs(u[0]) - 0.1;  // approaching
+    u[2] = 0.3;                    // a slip along the arm: out of K's range
+    Eigen::VectorXd P;
+    const ContactLawResult r = solve_contact_law(K, u, {{0.0, 50.0}}, P);
+    ASSERT_TRUE(P.allFinite()) << "trial " << trial;
+    const Eigen::VectorXd after = u + K * P;
+    // The normal approach is stopped (1e-9 m/s: Gauss-Seidel round-off on O(0.1..1) m/s velocities), the
+    // unreachable slip component is untouched, and no energy is added.
+    EXPECT_NEAR(after[0], 0.0, 1e-9) << "trial " << trial;
+    EXPECT_NEAR(after[2], u[2], 1e-9) << "trial " << trial;
+    EXPECT_LE(r.energy_change, 1e-12) << "trial " << trial;
+    // And the impulse is of the size the reachable change needs: |P| <= |du| / (smallest non-zero
+    // eigenvalue of K), not 1e15.
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+    EXPECT_LE(P.norm(), (after - u).norm() / eigen.eigenvalues()[1] * (1 + 1e-9)) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace aloft

@@ -203,7 +203,7 @@ TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
       const Vec3 s = state.orientation[p] * model.joint_in_parent[i];
       const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(after.velocity[p] + after.angular[p].cross(s));
       // Relative 1e-9 of O(1) velocities, the tree solve's accuracy.
-      EXPECT_LT((after.velocity[i] + after.angular[i].cross(r) - vp).norm(), 1e-9);
+      EXPECT_LT((after.velocity[i] + after.angular[i].cross(r) - vp).norm(), 1e-9) << "seed " << seed << " joint " << i;
     }
   }
   EXPECT_GT(sliding, 5);  // the sliding branch was exercised
