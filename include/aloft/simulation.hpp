@@ -100,6 +100,7 @@ class Simulation {
 
  private:
   bool rattle(double h);
+  bool contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) const;
   bool advance_by(double h, int depth);
   Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
 
