@@ -67,6 +67,8 @@ void add_plate(int shape, const Plate& plate, std::vector<ConvexPiece>& out) {
       vertices.push_back(p + half);
     }
     ConvexPiece piece = polytope(shape, std::move(vertices));
+    piece.prism_half = half;
+    for (int k : part) piece.prism_middle.push_back(plate.to_world(plate.points[k]));
     // Face normals of the prism: its two caps (the plate's normal) and one per side.
     piece.axes.push_back(plate.normal());
     for (std::size_t k = 0; k < part.size(); ++k) {
@@ -150,6 +152,19 @@ Vec3 ConvexPiece::support(const Vec3& d) const {
       return n > 0 ? Vec3(end + (radius / n) * across) : end;
     }
     case Kind::Polytope: {
+      if (!prism_middle.empty()) {
+        const Vec3* best = &prism_middle[0];
+        double best_dot = best->dot(d);
+        for (const Vec3& v : prism_middle) {
+          const double dot = v.dot(d);
+          if (dot > best_dot) {
+            best_dot = dot;
+            best = &v;
+          }
+        }
+        // The same vertex the full scan would return (p + h or p - h, whichever is farther along d).
+        return prism_half.dot(d) >= 0 ? Vec3(*best + prism_half) : Vec3(*best - prism_half);
+      }
       const Vec3* best = &vertices[0];
       double best_dot = best->dot(d);
       for (const Vec3& v : vertices) {

@@ -33,6 +33,10 @@ struct ConvexPiece {
   // Directions worth testing as a separating axis (body frame, unit, sign irrelevant): a polytope's face
   // normals, a cylinder's axis. The overlap test checks them besides EPA's answer (gjk_contact.cpp).
   std::vector<Vec3> axes;
+  // A plate's part is a prism: its vertices are mid-plane points p +- prism_half. support() then scans
+  // the mid-plane points only (half the vertices): max over p, s of (p + s h).d = max p.d + |h.d|.
+  std::vector<Vec3> prism_middle;  // body frame, m (empty: not a prism)
+  Vec3 prism_half = Vec3::Zero();  // half the thickness along the plate's normal, body frame, m
   Vec3 bound_center = Vec3::Zero();  // a sphere enclosing the piece (body frame, m)
   double bound_radius = 0;
 

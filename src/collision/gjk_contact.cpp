@@ -70,16 +70,13 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
                  double margin, PieceContact& out) {
   // Apart: GJK distance gives the closest points themselves. A sphere enters as its centre (its core)
   // and its radius is taken off afterwards: GJK on a point and a polytope ends in finitely many steps,
-  // on a round support it only converges.
-  auto core = [](const ConvexPiece& p) {
-    ConvexPiece c = p;
-    if (c.kind == ConvexPiece::Kind::Sphere) c.radius = 0;
-    return c;
-  };
+  // on a round support it only converges. (Only spheres are copied: they own no vertex arrays.)
+  ConvexPiece centre_a, centre_b;
+  const ConvexPiece& core_a = a.kind == ConvexPiece::Kind::Sphere ? (centre_a = a, centre_a.radius = 0, centre_a) : a;
+  const ConvexPiece& core_b = b.kind == ConvexPiece::Kind::Sphere ? (centre_b = b, centre_b.radius = 0, centre_b) : b;
   const double ra = a.kind == ConvexPiece::Kind::Sphere ? a.radius : 0.0;
   const double rb = b.kind == ConvexPiece::Kind::Sphere ? b.radius : 0.0;
-  const GjkResult g = (ra > 0 || rb > 0) ? gjk_distance(core(a), pose_a, core(b), pose_b)
-                                          : gjk_distance(a, pose_a, b, pose_b);
+  const GjkResult g = gjk_distance(core_a, pose_a, core_b, pose_b);
   if (!g.overlap && g.distance > ra + rb) {
     const double gap = g.distance - ra - rb;
     if (!(gap < margin)) return false;
@@ -132,13 +129,13 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   // overlap the other way, and the overlap correction then pushed one wire through the other). While a
   // wire's axis (a segment) or a sphere's centre is still outside the other piece, the direction between
   // the closest points of those cores is the separating one: try it too.
-  auto axis_core = [](const ConvexPiece& p) {
-    ConvexPiece c = p;
-    if (c.kind != ConvexPiece::Kind::Polytope) c.radius = 0;
-    return c;
-  };
   if (a.kind != ConvexPiece::Kind::Polytope || b.kind != ConvexPiece::Kind::Polytope) {
-    const GjkResult cores = gjk_distance(axis_core(a), pose_a, axis_core(b), pose_b);
+    // Copies only of the round pieces (no vertex arrays): their radius set to zero.
+    ConvexPiece round_a, round_b;
+    const bool polytope_a = a.kind == ConvexPiece::Kind::Polytope, polytope_b = b.kind == ConvexPiece::Kind::Polytope;
+    const ConvexPiece& axis_a = polytope_a ? a : (round_a = a, round_a.radius = 0, round_a);
+    const ConvexPiece& axis_b = polytope_b ? b : (round_b = b, round_b.radius = 0, round_b);
+    const GjkResult cores = gjk_distance(axis_a, pose_a, axis_b, pose_b);
     if (!cores.overlap && cores.distance > 0) {
       const Vec3 n = (cores.on_a - cores.on_b) / cores.distance;
       const double gap = gap_along(a, pose_a, b, pose_b, n);
