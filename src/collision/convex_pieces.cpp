@@ -80,27 +80,16 @@ void add_plate(int shape, const Plate& plate, std::vector<ConvexPiece>& out) {
   }
 }
 
-// The face normals of the tetrahedron (a, b, c, apex): the triangle's and those of its three sides
-// through `apex`.
-std::vector<Vec3> triangle_solid_axes(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& apex) {
+// The face normals of a solid built on the triangle (a, b, c): the triangle's own, and for each edge pq
+// the side face containing that edge and the direction towards(p) (a tetrahedron's apex minus p, or a
+// prism's extrusion).
+template <class Towards>
+std::vector<Vec3> triangle_solid_axes(const Vec3& a, const Vec3& b, const Vec3& c, Towards towards) {
   std::vector<Vec3> axes;
   const Vec3 n = (b - a).cross(c - a);
   if (n.norm() > 0) axes.push_back(n.normalized());
   for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-    const Vec3 side = (q - p).cross(apex - p);
-    if (side.norm() > 0) axes.push_back(side.normalized());
-  }
-  return axes;
-}
-
-// The face normals of the triangle (a, b, c) extruded by `offset`: its caps and its three sides (each
-// containing an edge and the offset).
-std::vector<Vec3> prism_axes(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& offset) {
-  std::vector<Vec3> axes;
-  const Vec3 n = (b - a).cross(c - a);
-  if (n.norm() > 0) axes.push_back(n.normalized());
-  for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-    const Vec3 side = (q - p).cross(offset);
+    const Vec3 side = (q - p).cross(towards(p));
     if (side.norm() > 0) axes.push_back(side.normalized());
   }
   return axes;
@@ -125,11 +114,11 @@ void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     if (star) {
       out.push_back(polytope(shape, {a, b, c, centroid}));
-      out.back().axes = triangle_solid_axes(a, b, c, centroid);
+      out.back().axes = triangle_solid_axes(a, b, c, [&](const Vec3& p) { return Vec3(centroid - p); });
     } else {
       const Vec3 inward = -kShellThickness * (b - a).cross(c - a).normalized();
       out.push_back(polytope(shape, {a, b, c, a + inward, b + inward, c + inward}));
-      out.back().axes = prism_axes(a, b, c, inward);
+      out.back().axes = triangle_solid_axes(a, b, c, [&](const Vec3&) { return inward; });
     }
   }
 }

@@ -29,14 +29,14 @@ constexpr double kJointTolerance = 1e-9;
 constexpr int kMaxJointIterations = 8;
 // A step whose joint impulses do not converge is split in two, recursively, at most this deep.
 constexpr int kMaxSubdivision = 8;
-// Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
-// millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
-// list from one step to the next without testing pieces that are far apart.
 // The most (m) any point of a component in contact may travel in one step (see
 // contacts_move_slowly_enough): a third of the thinnest sheet of the presets (1.5 mm). Measured on the
 // Steel Fish shaken hard for 600 s: with no such limit, pieces knocked at 2-5 m/s overlapped by up to
-// 4.2 mm within a step; with 0.5 mm, by less than a micrometre.
+// 4.2 mm within a step; with 0.5 mm, by less than a micrometre (1 mm still let 1.5 mm through).
 constexpr double kMaxContactTravel = 5e-4;
+// Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
+// millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
+// list from one step to the next without testing pieces that are far apart.
 constexpr double kContactMargin = 5e-4;
 // Contacts re-checked after the joints' impulses: at most this many corrections per step, each when a
 // contact approaches faster than this (m/s; 1e-6 m/s closes 1 nm per step).
@@ -190,20 +190,21 @@ inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& mo
   return f;
 }
 
-// Whether every component in a contact found for this step moves (any point of it, at the given
-// velocities) at most kMaxContactTravel in a step of h. A contact is a constraint at one point with one
-// normal, from the closest features at the start of the step; a plate edge sweeping several millimetres
-// per step past a 2 mm wire can pierce it away from that point before the next step sees it. Always
-// true for the shortest step the subdivision allows (it must make progress).
+// With collisions on: whether no component turns more than kOldTurnLimit in a step of h, and every
+// component in a contact found for this step moves (any point of it, at the given velocities) at most
+// kMaxContactTravel. A contact is a constraint at one point with one normal, from the closest features
+// at the start of the step; a plate edge sweeping several millimetres per step past a 2 mm wire can
+// pierce it away from that point before the next step sees it. Always true for the shortest step the
+// subdivision allows (it must make progress).
 bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity,
                                               const std::vector<Vec3>& angular) const {
   const StepWorkspace& work = *work_;
   if (!(h > std::ldexp(timestep_, -kMaxSubdivision) * 1.5)) return true;
-  // And, with collisions on, no component turns more than the old rule's kOldTurnLimit in a step. The
-  // drift-error rule alone lets a fast spinner turn up to kMaxTurn (4 times more); a component a knock
-  // sends spinning, or that the joints' corrections speed up after detection, then sweeps past the
-  // contacts found at the start of the step: on the Steel Fish shaken hard, overlaps of 9-18 mm
-  // within 80 s with the drift-error rule alone, none above a micrometre in 600 s with this limit too.
+  // The turn: the drift-error rule alone lets a fast spinner turn up to kMaxTurn (4 times more); a
+  // component a knock sends spinning, or that the joints' corrections speed up after detection, then
+  // sweeps past the contacts found at the start of the step: on the Steel Fish shaken hard, overlaps of
+  // 9-18 mm within 80 s with the drift-error rule alone, none above 0.4 micrometres in 120 s with this
+  // limit too.
   for (std::size_t i = 1; i < angular.size(); ++i)
     if (h * angular[i].norm() > kOldTurnLimit) return false;
   for (const Contact& c : work.contacts) {
