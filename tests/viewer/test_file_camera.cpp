@@ -18,22 +18,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_aloft.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+const auto quote = aloft::test::shell_quote;
+const auto read = aloft::test::read_file;
 
 struct Image {
   int width = 0, height = 0;

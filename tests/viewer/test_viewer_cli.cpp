@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "support/run_aloft.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -25,18 +27,8 @@ struct Result {
   std::string out;
 };
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+const auto quote = aloft::test::shell_quote;
+const auto read = aloft::test::read_file;
 
 // An RGB image read from a PNG.
 struct Image {

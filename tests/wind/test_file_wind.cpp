@@ -16,6 +16,8 @@
 #include <regex>
 #include <string>
 
+#include "support/run_aloft.hpp"
+
 #include "mobile_session.hpp"
 #include "wind/wind_scenes.hpp"
 
@@ -146,23 +148,8 @@ TEST_F(FileWindTest, SessionSwitchesSourcesAndKeepsTheSwitchAcrossAReload) {
   EXPECT_EQ(session.simulation().loads().force[1], Vec3::Zero());
 }
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr
-};
-
-Result aloft(const std::string& arguments) {
-  const std::string command = std::string(ALOFT_CLI) + " " + arguments + " 2>&1";
-  Result r;
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = CliResult;
+const auto aloft = run_aloft;  // aloft("simulate ...")
 
 // The largest displacement from rest that `aloft simulate` reports (m), or -1.
 double largest_move(const std::string& output) {

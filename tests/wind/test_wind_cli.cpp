@@ -9,26 +9,13 @@
 #include <memory>
 #include <string>
 
+#include "support/run_aloft.hpp"
+
 namespace aloft::test {
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr
-};
-
-Result aloft(const std::string& arguments) {
-  const std::string command = std::string(ALOFT_CLI) + " " + arguments + " 2>&1";
-  Result r;
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = CliResult;
+const auto aloft = run_aloft;  // aloft("simulate ...")
 
 const std::string fish = std::string(ALOFT_SOURCE_DIR) + "/mobiles/steel-fish.json";
 
