@@ -9,6 +9,7 @@
 
 #include "collision/gjk_distance.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -100,6 +101,12 @@ bool closest_to_origin(Simplex& s, std::array<double, 4>& w, Vec3& closest) {
       // Origin inside the tetrahedron: on the inner side of all four faces. Otherwise the closest of
       // the faces it is outside of.
       const std::array<std::array<int, 4>, 4> faces = {{{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1}, {1, 2, 3, 0}}};
+      // A flat tetrahedron (four points in a plane, up to round-off: thin or parallel pieces make them)
+      // has no inside, and its inside test is decided by round-off: it reported pieces millimetres apart
+      // as overlapping. Then the closest of all four faces is taken.
+      const Vec3 &p0 = in.v[0].w, &p1 = in.v[1].w, &p2 = in.v[2].w, &p3 = in.v[3].w;
+      const double edge = std::max({(p1 - p0).norm(), (p2 - p0).norm(), (p3 - p0).norm()});
+      const bool flat = std::abs((p1 - p0).dot((p2 - p0).cross(p3 - p0))) <= 1e-9 * edge * edge * edge;
       double best = INFINITY;
       bool outside_any = false;
       Simplex best_s;
@@ -108,7 +115,7 @@ bool closest_to_origin(Simplex& s, std::array<double, 4>& w, Vec3& closest) {
         const Vec3 &p = in.v[f[0]].w, &q = in.v[f[1]].w, &r = in.v[f[2]].w, &o = in.v[f[3]].w;
         const Vec3 n = (q - p).cross(r - p);
         const double side_origin = -n.dot(p), side_other = n.dot(o - p);
-        if (side_origin * side_other >= 0) continue;  // origin on the same side as the fourth vertex
+        if (!flat && side_origin * side_other >= 0) continue;  // origin on the same side as the fourth vertex
         outside_any = true;
         Simplex t;
         std::array<double, 4> tw{};
