@@ -49,11 +49,14 @@ struct CollisionStatistics {
   long long impulses = 0;             // contact impulses applied (one per active contact per step)
   long long sliding = 0;              // of those, sliding on the friction cone's edge
   long long restitution_dropped = 0;  // steps where bouncing would have added energy (solved with e = 0)
+  long long friction_dropped = 0;     // steps where even that gained (nearly dependent contacts): solved
+                                      // without friction, or without impulse
   double energy_removed = 0;          // J of kinetic energy the impulses took out (>= 0)
   double deepest = 0;                 // m, largest overlap seen at the start of a step
 };
 
 struct StepWorkspace;  // solver factorization and scratch (dynamics/simulation.cpp)
+struct ContactStepReport;  // what the contact stage did in one step (dynamics/contact_response.hpp)
 
 class Simulation {
  public:
@@ -102,6 +105,11 @@ class Simulation {
   bool rattle(double h);
   bool contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) const;
   bool advance_by(double h, int depth);
+  // rattle()'s drift: what one pass corrects before drifting (see simulation.cpp).
+  enum class DriftCorrection { kNone, kVelocity, kPseudo };
+  double drift_pass(double h, DriftCorrection correction, bool with_pseudo);
+  bool push_apart(double h);
+  bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
   Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
 
   const Model& model_;

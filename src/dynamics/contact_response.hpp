@@ -20,7 +20,9 @@
 // frictionless "pseudo-velocity" that moves positions in this step's drift only and is then forgotten
 // (split impulse), so correcting it adds no kinetic energy.
 // If the Newton restitution targets would add kinetic energy (possible with sticking friction and
-// several contacts), the step's impulses are recomputed with e = 0, which only removes energy.
+// several contacts), the step's impulses are recomputed with e = 0, which only removes energy. If even
+// that gains (the friction law's Gauss-Seidel need not converge on nearly dependent contacts), they are
+// recomputed without friction, and dropped for this step if that gains too.
 
 #include <utility>
 #include <vector>
@@ -52,6 +54,8 @@ struct ContactStepReport {
   int sliding = 0;
   int iterations = 0;          // Gauss-Seidel sweeps of the contact law
   bool restitution_dropped = false;  // Newton restitution would have added energy: solved with e = 0
+  bool friction_dropped = false;     // the law with friction added energy (nearly dependent contacts):
+                                     // solved frictionless, or with no impulse if that gained too
   double energy_change = 0;    // J, kinetic energy the impulses changed (<= 0 up to round-off)
   double deepest = 0;          // m, largest overlap among the contacts (>= 0)
 };
