@@ -110,6 +110,8 @@ class Simulation {
   double drift_pass(double h, DriftCorrection correction, bool with_pseudo);
   bool push_apart(double h);
   bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
+  bool at_finest_step(double h) const;
+  bool reject_spin(double h);
   Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
 
   const Model& model_;

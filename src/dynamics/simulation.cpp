@@ -103,6 +103,12 @@ struct StepWorkspace {
   State probe;                    // the current pose with the half-step velocities, for detection
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
+  // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
+  // reports. kStepRule: `rejected_body` spins too fast (`rejected_value` its turn per step, rad);
+  // kJoints: its joint stayed open (`rejected_value` the gap, m).
+  enum class Rejection { kNone, kStepRule, kJoints } rejection = Rejection::kNone;
+  int rejected_body = 0;
+  double rejected_value = 0;
 };
 
 namespace {
@@ -201,6 +207,29 @@ inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& mo
   return f;
 }
 
+// Whether h is the shortest (sub)step the subdivision allows.
+bool Simulation::at_finest_step(double h) const { return !(h > std::ldexp(timestep_, -kMaxSubdivision) * 1.5); }
+
+// The step-size rule rejected the half-kicked velocities work.next.angular: note, for a failure at the
+// shortest step, the body that spins fastest for its limits, and return false.
+bool Simulation::reject_spin(double h) {
+  StepWorkspace& work = *work_;
+  if (at_finest_step(h)) {
+    const TreeSolver& solver = work.solver;
+    const StepSizeMeasures m = work.step_rule.measure(h, work.next.angular, solver.world_inertia(),
+                                                      solver.world_inverse_inertia(), solver.child_arm(),
+                                                      solver.parent_arm());
+    int body = m.turn_body;
+    double worst = m.turn;
+    if (!(m.anchor_turn <= worst)) worst = m.anchor_turn, body = m.anchor_turn_body;
+    if (!(m.drift_error <= worst)) body = m.drift_error_body;
+    work.rejection = StepWorkspace::Rejection::kStepRule;
+    work.rejected_body = body;
+    work.rejected_value = h * work.next.angular[body].norm();
+  }
+  return false;
+}
+
 // With collisions on: whether no component turns more than kOldTurnLimit in a step of h, and every
 // component in a contact found for this step moves (any point of it, at the given velocities) at most
 // kMaxContactTravel. A contact is a constraint at one point with one normal, from the closest features
@@ -210,7 +239,7 @@ inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& mo
 bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity,
                                               const std::vector<Vec3>& angular) const {
   const StepWorkspace& work = *work_;
-  if (!(h > std::ldexp(timestep_, -kMaxSubdivision) * 1.5)) return true;
+  if (at_finest_step(h)) return true;
   // The turn: the drift-error rule alone lets a fast spinner turn up to kMaxTurn (4 times more); a
   // component a knock sends spinning, or that the joints' corrections speed up after detection, then
   // sweeps past the contacts found at the start of the step: on the Steel Fish shaken hard, overlaps of
@@ -341,7 +370,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   if (collisions_) {
     // A step that will be halved as too long for its spins (checked again below, after the impulses) is
     // not worth a detection whose margins its speeds would make huge.
-    if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return false;
+    if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return reject_spin(h);
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
@@ -387,7 +416,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
   // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
   // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
-  if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return false;
+  if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return reject_spin(h);
   // The impulses may have knocked a component in contact faster than the check above allowed.
   return !collisions_ || contacts_move_slowly_enough(h, next.velocity, next.angular);
 }
@@ -462,7 +491,25 @@ bool Simulation::rattle(double h) {
       continue;
     }
     // Not converging (too many iterations, growing or non-finite gaps): give up on this h.
-    if (newton_gives_up(iteration, worst, previous_worst)) return false;
+    if (newton_gives_up(iteration, worst, previous_worst)) {
+      if (at_finest_step(h)) {
+        work.rejection = StepWorkspace::Rejection::kJoints;
+        work.rejected_value = -1;  // the widest gap, or NaN at the first joint whose gap is not finite
+        for (int i = 1; i < n; ++i) {
+          if (!c[i].allFinite()) {
+            work.rejected_value = NAN;
+            work.rejected_body = i;
+            break;
+          }
+          const double gap = h * c[i].cwiseAbs().maxCoeff();
+          if (gap > work.rejected_value) {
+            work.rejected_value = gap;
+            work.rejected_body = i;
+          }
+        }
+      }
+      return false;
+    }
     previous_worst = worst;
     solver.solve_rows(c, du, &c);  // c now holds this iteration's joint impulses
     ++work.joint_iterations;
@@ -534,6 +581,8 @@ bool Simulation::advance_by(double h, int depth) {
 bool Simulation::step() {
   const double start = state_.time;
   const long long subdivisions_before = work_->subdivisions;
+  work_->rejection = StepWorkspace::Rejection::kNone;
+  work_->rejected_value = 0;
   const bool converged = advance_by(timestep_, 0);
 
   // Check: a non-finite state (or one the solver cannot close) stops the simulation with a report.
@@ -552,17 +601,29 @@ bool Simulation::step() {
         bad = i;
         break;
       }
+    const StepWorkspace& work = *work_;
+    using Rejection = StepWorkspace::Rejection;
+    if (std::isfinite(sum) && work.rejection != Rejection::kNone) bad = work.rejected_body;
+    const bool non_finite = !std::isfinite(sum) || !std::isfinite(work.rejected_value);
     SimulationFailure fail;
     fail.component = bad;
     fail.component_name = model_.names[bad];
     fail.time = start + timestep_;
     std::ostringstream msg;
-    msg << "the simulation became non-finite at t = " << fail.time << " s (step " << steps_ + 1 << "): ";
-    if (std::isfinite(sum))
-      msg << "the joints could not be closed even with the step divided " << (1 << kMaxSubdivision)
-          << " times (near component '" << model_.names[bad] << "')";
-    else
+    msg << "the simulation " << (non_finite ? "became non-finite" : "stopped") << " at t = " << fail.time
+        << " s (step " << steps_ + 1 << "): ";
+    if (non_finite) {
       msg << "component '" << model_.names[bad] << "' has a NaN or infinite position, velocity or angular velocity";
+    } else if (work.rejection == Rejection::kStepRule) {
+      msg << "component '" << model_.names[bad] << "' spins too fast even for the step divided "
+          << (1 << kMaxSubdivision) << " times (it would turn " << work.rejected_value
+          << " rad in that step, beyond the step-size rule's limits)";
+    } else {
+      msg << "the joints could not be closed even with the step divided " << (1 << kMaxSubdivision) << " times";
+      if (work.rejection == Rejection::kJoints)
+        msg << " (the widest gap, " << work.rejected_value << " m, at the joint of component '" << model_.names[bad]
+            << "')";
+    }
     msg << "; the last finite state is kept";
     fail.message = msg.str();
     failure_ = fail;

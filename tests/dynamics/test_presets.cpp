@@ -84,9 +84,29 @@ TEST(Simulation, NonFiniteStateIsReportedWithComponentAndTime) {
   EXPECT_NEAR(sim.failure()->time, 0.011, 1e-12);
   EXPECT_NE(sim.failure()->message.find(model.names[bad]), std::string::npos);
   EXPECT_NE(sim.failure()->message.find("t = 0.011"), std::string::npos);
+  EXPECT_NE(sim.failure()->message.find("NaN or infinite"), std::string::npos) << sim.failure()->message;
   // The last finite state is kept.
   EXPECT_EQ(sim.state().time, before.time);
   EXPECT_TRUE(sim.state().position[3].allFinite());
+}
+
+// A component spun far beyond what any step can follow (1e6 rad/s: 3.9 rad even in a 1/256 ms step,
+// beyond the step-size rule's 0.2 rad) stops the simulation with a report that names it and says why,
+// not a joint that failed to close nor the first component in the tree.
+TEST(Simulation, ASpinNoStepCanFollowIsReportedWithItsComponent) {
+  const Model model = load_mobile(test::preset_path("steel-fish"));
+  Simulation sim(model);
+  ASSERT_TRUE(sim.advance(0.01));
+  const int spinner = 5;
+  sim.mutable_state().angular[spinner] = Vec3(0, 1e6, 0);
+  const double before = sim.state().time;
+  EXPECT_FALSE(sim.step());
+  ASSERT_TRUE(sim.failure().has_value());
+  EXPECT_EQ(sim.failure()->component, spinner);
+  EXPECT_EQ(sim.failure()->component_name, model.names[spinner]);
+  const std::string& message = sim.failure()->message;
+  EXPECT_NE(message.find("'" + model.names[spinner] + "' spins too fast"), std::string::npos) << message;
+  EXPECT_EQ(sim.state().time, before);
 }
 
 }  // namespace
