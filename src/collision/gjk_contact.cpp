@@ -79,13 +79,17 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   const GjkResult g = gjk_distance(core_a, pose_a, core_b, pose_b);
   if (!g.overlap && g.distance > ra + rb) {
     const double gap = g.distance - ra - rb;
-    if (!(gap < margin)) return false;
+    if (!(gap < margin)) {
+      out.distance = gap;  // a bound for the detector's coherence (narrow_phase.hpp)
+      return false;
+    }
     out.normal = (g.on_a - g.on_b) / g.distance;
     out.distance = gap;
     out.point = 0.5 * ((g.on_a - ra * out.normal) + (g.on_b + rb * out.normal));
     return true;
   }
   // Overlapping: libccd's EPA on the pieces inflated by margin / 2 each (see the top of this file).
+  out.distance = 0;  // nothing known, should this end without a contact
   static const ccd_t ccd = make_ccd();
   const Inflated ia{&a, &pose_a, 0.5 * margin}, ib{&b, &pose_b, 0.5 * margin};
   ccd_real_t depth = 0;

@@ -39,12 +39,15 @@ bool cylinder_cylinder_sides(const Vec3& from_a, const Vec3& to_a, double ra, co
                              const Vec3& to_b, double rb, PieceContact& out);
 
 // Support-function contact: GJK distance when apart, libccd's EPA when overlapping. True, with `out`,
-// when the signed distance is below `margin` (> 0).
+// when the signed distance is below `margin` (> 0). When false, out.distance is a lower bound of the
+// signed distance to within GJK's relative 1e-6 (>= margin when the pieces were measured apart; 0 when
+// nothing is known).
 bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                  double margin, PieceContact& out);
 
 // The contact of two pieces when their signed distance is below `margin` (> 0): closed forms where
-// they apply, GJK/EPA otherwise.
+// they apply, GJK/EPA otherwise. When false, out.distance is a lower bound as for gjk_contact() (the
+// closed forms' distance is exact).
 bool piece_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                    double margin, PieceContact& out);
 
