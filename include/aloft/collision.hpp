@@ -75,7 +75,8 @@ class CollisionDetector {
   // where a component's speed bound is |v| + |w| * (its largest distance from its centre of mass to
   // its surface). `step` in s, base_margin in m. Replaces the contents of `contacts`; at most a few
   // contacts per pair (one per pair of convex pieces that come close). Deterministic: the same state
-  // gives the same contacts in the same order. Does not allocate once warmed up.
+  // gives the same contacts in the same order, whatever states the detector saw before (it remembers
+  // distances between calls only to skip pairs that cannot touch). Does not allocate once warmed up.
   void find_contacts(const State& state, double step, double base_margin, std::vector<Contact>& contacts);
 
  private:

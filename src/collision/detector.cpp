@@ -168,7 +168,8 @@ CollisionDetector::CollisionDetector(const Model& model)
   d.last_position.assign(model.count, Vec3::Zero());
   d.odometer.assign(model.count, 0.0);
   for (const ComponentGeometry& g : d.geometry) d.max_pieces = std::max<std::uint64_t>(d.max_pieces, g.pieces.size());
-  // 16 slots per component with shapes, 1024 to 65536 (1.5 MiB): room for the pairs near each other.
+  // 16 slots per component with shapes, 1024 to 65536 (32 bytes each, 2 MiB at most): room for the
+  // piece pairs near each other.
   std::size_t slots = 1024;
   while (slots < 16 * d.members.size() && slots < 65536) slots *= 2;
   d.bounds.resize(slots);

@@ -411,11 +411,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     }
   }
 
-  // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
-  // the implicit midpoint of that flow: q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
-  // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
-  // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
-  // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
+  // The step-size rule on the velocities the drift will use.
   if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return reject_spin(h);
   // The impulses may have knocked a component in contact faster than the check above allowed.
   return !collisions_ || contacts_move_slowly_enough(h, next.velocity, next.angular);
@@ -461,6 +457,11 @@ bool Simulation::rattle(double h) {
     if (!suspicious || !kick_and_collide(h, false, contact_report, has_pseudo)) return false;
   }
 
+  // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
+  // the implicit midpoint of that flow: q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
+  // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
+  // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
+  // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
   for (int i = 1; i < n; ++i) {
     const Quat half = turned(0.5 * h * next.angular[i], now.orientation[i]);
     const Mat3 rot = half.toRotationMatrix();
