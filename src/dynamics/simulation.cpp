@@ -23,8 +23,8 @@ void ExternalLoads::clear() {
 namespace {
 
 // Joint positions must agree to this (m) before a step is accepted: 1000 times below what a joint may
-// ever separate (1e-6 m). Warm-started with impulses extrapolated from the last two steps, the Newton
-// iteration on the joint impulses usually gets there with one tree solve.
+// ever separate (1e-6 m). Warm-started with impulses predicted from the last two steps (see the half
+// kick), the Newton iteration on the joint impulses usually gets there with one tree solve.
 constexpr double kJointTolerance = 1e-9;
 constexpr int kMaxJointIterations = 8;
 // A step whose joint impulses do not converge is split in two, recursively, at most this deep.
@@ -62,7 +62,8 @@ struct StepWorkspace {
         impulse(model.count, Vec3::Zero()),
         step_impulse(model.count, Vec3::Zero()),
         drift_map(model.count, Mat3::Identity()),
-        older_impulse(model.count, Vec3::Zero()),
+        projection(model.count, Vec3::Zero()),
+        older_projection(model.count, Vec3::Zero()),
         rotation(model.count, Mat3::Identity()),
         child_arm(model.count, Vec3::Zero()),
         parent_arm(model.count, Vec3::Zero()),
@@ -85,9 +86,10 @@ struct StepWorkspace {
   std::vector<Vec3> impulse;     // joint impulses of the last step (N s), for the warm start
   std::vector<Vec3> step_impulse;  // joint impulses being accumulated in this step
   std::vector<Mat3> drift_map;   // per body: kicked angular velocity -> drift angular velocity
-  std::vector<Vec3> older_impulse;  // joint impulses of the step before the last
-  double impulse_step = 0;       // the step length (s) the stored joint impulses belong to
-  double older_step = 0;         // and the one of older_impulse
+  std::vector<Vec3> projection;  // joint impulses of the last step's second half kick (N s), at its end
+  std::vector<Vec3> older_projection;  // and of the step before
+  double impulse_step = 0;       // the step length (s) impulse and projection belong to
+  double older_step = 0;         // and the one of older_projection
   std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
   std::vector<Vec3> child_arm;   // at next's pose: R_i joint_in_child[i] (handed to the solver's factor)
   std::vector<Vec3> parent_arm;  // at next's pose: R_p joint_in_parent[i]
@@ -339,15 +341,22 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   const std::vector<Mat3>& inertia = solver.world_inertia();
   const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
-  // 1. Half kick: applied impulses (h/2) f at the current state plus a guess of the joint impulses P
-  //    (extrapolated from the last two steps, or the last one scaled to this step's length), which act
-  //    on the child as (P, r x P) and on the parent as -(P, s x P). Parents come first (parent[i] < i),
-  //    so f[p] is set before its children subtract from it.
-  const bool extrapolate = guess && work.older_step == work.impulse_step && work.impulse_step == h;
+  // 1. Half kick: applied impulses (h/2) f at the current state plus a guess of the joint impulses P,
+  //    which act on the child as (P, r x P) and on the parent as -(P, s x P). Parents come first
+  //    (parent[i] < i), so f[p] is set before its children subtract from it. The guess, when the last two
+  //    steps had this length: P = M_n + (P_n - M_n-1), where P_n is the last step's first-kick impulse
+  //    and M_n, M_n-1 the second-kick (velocity projection) impulses of the last two steps. M_n acts at
+  //    this step's pose, where P will; P_n and M_n-1 both acted at the last step's start, and their
+  //    difference (what closing the joints at the end of a drift needs beyond making the velocities
+  //    tangent: the curvature of the joints' paths) changes slowly. Measured against extrapolating P
+  //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.19 -> 1.00 on the Steel Fish,
+  //    3.07 -> 2.10 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's P
+  //    scaled to this step's length.
+  const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
   for (int i = 1; i < n; ++i) {
-    const Vec3 impulse =
-        extrapolate ? Vec3(2.0 * work.impulse[i] - work.older_impulse[i]) : Vec3(warm * work.impulse[i]);
+    const Vec3 impulse = predict ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
+                                 : Vec3(warm * work.impulse[i]);
     work.step_impulse[i] = impulse;
     f[i] = (0.5 * h) * applied_wrench(now, i, inertia[i] * now.angular[i]);
     f[i].head<3>() += impulse;
@@ -443,8 +452,8 @@ bool Simulation::rattle(double h) {
   // 1. The half kick and the contacts. A rejection after a kick that changed some body's turn per step
   //    by more than kSuspiciousKick is tried once more without the guessed joint impulses: the guess is
   //    only a starting point for SHAKE, and a wrong one (a force going round a loop that a contact
-  //    closes, which the contact cancels every step while the warm start carries it on and the
-  //    extrapolation doubles it) must not halve the step down to failure at the finest step, as it did
+  //    closes, which the contact cancels every step while the warm start carries it on, and which the
+  //    extrapolation used until then doubled) must not halve the step down to failure at the finest step, as it did
   //    for generated-1023 after a breeze (t = 0.6 s; Collisions.CrowdedGeneratedMobileInABreezeKeepsGoing)
   //    and, in a version without this retry, for the shaken Steel Fish (t = 48 s). Kicked without a
   //    guess, SHAKE finds the joint impulses afresh, and the loop force is gone.
@@ -523,7 +532,6 @@ bool Simulation::rattle(double h) {
   //     generated-1023 after a breeze, this alone moved the failure described above from t = 0.6 s to
   //     0.8 s.) If the pass does not close the joints, the overlap is left for the next step.
   if (has_pseudo && !push_apart(h)) drift_pass(h, DriftCorrection::kNone, false);
-  std::swap(work.older_impulse, work.impulse);
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
@@ -545,7 +553,8 @@ bool Simulation::rattle(double h) {
     const Vec3 parent_point = next.velocity[p] + next.angular[p].cross(s[i]);
     c[i] = parent_point - child_point;
   }
-  solver.solve(f, c, du);
+  std::swap(work.older_projection, work.projection);
+  solver.solve(f, c, du, &work.projection);
   double sum = 0;
   for (int i = 1; i < n; ++i) {
     next.velocity[i] += du[i].head<3>();
