@@ -349,8 +349,8 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   //    this step's pose, where P will; P_n and M_n-1 both acted at the last step's start, and their
   //    difference (what closing the joints at the end of a drift needs beyond making the velocities
   //    tangent: the curvature of the joints' paths) changes slowly. Measured against extrapolating P
-  //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.19 -> 1.00 on the Steel Fish,
-  //    3.07 -> 2.10 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's P
+  //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.14 -> 0.96 on the Steel Fish,
+  //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's P
   //    scaled to this step's length.
   const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
