@@ -125,6 +125,24 @@ void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out
 
 }  // namespace
 
+namespace {
+
+// The first of `points` (non-empty) farthest along d.
+const Vec3& farthest_along(const std::vector<Vec3>& points, const Vec3& d) {
+  const Vec3* best = &points[0];
+  double best_dot = best->dot(d);
+  for (const Vec3& v : points) {
+    const double dot = v.dot(d);
+    if (dot > best_dot) {
+      best_dot = dot;
+      best = &v;
+    }
+  }
+  return *best;
+}
+
+}  // namespace
+
 Vec3 ConvexPiece::support(const Vec3& d) const {
   switch (kind) {
     case Kind::Sphere: {
@@ -142,28 +160,11 @@ Vec3 ConvexPiece::support(const Vec3& d) const {
     }
     case Kind::Polytope: {
       if (!prism_middle.empty()) {
-        const Vec3* best = &prism_middle[0];
-        double best_dot = best->dot(d);
-        for (const Vec3& v : prism_middle) {
-          const double dot = v.dot(d);
-          if (dot > best_dot) {
-            best_dot = dot;
-            best = &v;
-          }
-        }
+        const Vec3& best = farthest_along(prism_middle, d);
         // The same vertex the full scan would return (p + h or p - h, whichever is farther along d).
-        return prism_half.dot(d) >= 0 ? Vec3(*best + prism_half) : Vec3(*best - prism_half);
+        return prism_half.dot(d) >= 0 ? Vec3(best + prism_half) : Vec3(best - prism_half);
       }
-      const Vec3* best = &vertices[0];
-      double best_dot = best->dot(d);
-      for (const Vec3& v : vertices) {
-        const double dot = v.dot(d);
-        if (dot > best_dot) {
-          best_dot = dot;
-          best = &v;
-        }
-      }
-      return *best;
+      return farthest_along(vertices, d);
     }
   }
   return a;

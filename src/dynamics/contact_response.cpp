@@ -61,6 +61,15 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   }
 }
 
+void ContactResponse::solve_frictionless(int m, const Eigen::VectorXd& un, const Eigen::VectorXd& target,
+                                         Eigen::VectorXd& P) const {
+  const auto normal = Eigen::seqN(0, m, 3);  // the normal row of each contact
+  Eigen::VectorXd Pn;
+  solve_normal_law(K_(normal, normal), un, target, Pn);
+  P = Eigen::VectorXd::Zero(3 * m);
+  P(normal) = Pn;
+}
+
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
                                            const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
@@ -169,21 +178,14 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   // Block Gauss-Seidel with friction need not converge when the contacts' rows are nearly dependent (two
   // contacts between the same bodies, or a loop closed through a joint): on the shaken Steel Fish, with K's
   // smallest eigenvalue 1e-5 of its largest, it returned impulses of ~1 N s that added 0.2 J, and the
-  // next halved steps flung a fish at 1700 rad/s. Such a step is solved without friction and without
+  // next halved steps flung a component at 1700 rad/s. Such a step is solved without friction and without
   // bounce (the normal law alone is a convex problem: it converges and only removes energy), and should
   // even that gain, with no impulse at all (the speculative targets try again next step).
   if (gained(law)) {
     set_targets(false);
-    Eigen::MatrixXd Knn(m, m);
-    Eigen::VectorXd un(m), target(m), Pn;
-    for (int i = 0; i < m; ++i) {
-      for (int j = 0; j < m; ++j) Knn(i, j) = K_(3 * i, 3 * j);
-      un[i] = u_[3 * i];
-      target[i] = rows_[i].target_normal;
-    }
-    solve_normal_law(Knn, un, target, Pn);
-    P_.setZero();
-    for (int k = 0; k < m; ++k) P_[3 * k] = Pn[k];
+    Eigen::VectorXd target(m);
+    for (int k = 0; k < m; ++k) target[k] = rows_[k].target_normal;
+    solve_frictionless(m, u_(Eigen::seqN(0, m, 3)), target, P_);
     law.sticking = 0;
     law.sliding = 0;
     law.energy_change = contact_energy_change(K_, u_, P_);
@@ -212,7 +214,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
 
   // Split impulse: a frictionless pseudo-velocity that removes a part of each overlap beyond the slop.
   bool penetrating = false;
-  Eigen::VectorXd target = Eigen::VectorXd::Zero(m), un = Eigen::VectorXd::Zero(m), Pn;
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(m);
   for (int k = 0; k < m; ++k) {
     const double overlap = -contacts[k].distance - tuning.penetration_slop;
     if (overlap > 0) {
@@ -221,12 +223,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     }
   }
   if (penetrating) {
-    Eigen::MatrixXd Knn(m, m);
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j < m; ++j) Knn(i, j) = K_(3 * i, 3 * j);
-    solve_normal_law(Knn, un, target, Pn);
-    Eigen::VectorXd P = Eigen::VectorXd::Zero(3 * m);
-    for (int k = 0; k < m; ++k) P[3 * k] = Pn[k];
+    Eigen::VectorXd P;
+    solve_frictionless(m, Eigen::VectorXd::Zero(m), target, P);
     respond(contacts, P, false);
     for (int i = 0; i < model_.count; ++i) pseudo[i] = i == 0 ? Vec6::Zero() : du_[i];
     has_pseudo = true;
