@@ -105,9 +105,11 @@ class Simulation {
   bool rattle(double h);
   bool contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) const;
   bool advance_by(double h, int depth);
-  // rattle()'s drift: what one pass corrects before drifting (see simulation.cpp).
-  enum class DriftCorrection { kNone, kVelocity, kPseudo };
-  double drift_pass(double h, DriftCorrection correction, bool with_pseudo);
+  // rattle()'s drift (see simulation.cpp): a plain pass, and a Newton correction of the half-step
+  // velocities or of the pseudo-velocities followed by a pass.
+  enum class DriftCorrection { kVelocity, kPseudo };
+  double drift_pass(double h, bool first_of_step, bool with_pseudo);
+  double correct_and_drift(double h, DriftCorrection correction, bool with_pseudo);
   bool push_apart(double h);
   bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
   bool at_finest_step(double h) const;

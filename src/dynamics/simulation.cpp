@@ -57,6 +57,7 @@ struct StepWorkspace {
         next(rest_state(model)),
         backup(rest_state(model)),
         wrench(model.count, Vec6::Zero()),
+        kick_sum(model.count, Vec6::Zero()),
         rows(model.count, Vec3::Zero()),
         correction(model.count, Vec6::Zero()),
         impulse(model.count, Vec3::Zero()),
@@ -81,8 +82,10 @@ struct StepWorkspace {
   State backup;                  // the state before a subdivided step, to return to if it fails (sized
                                  // here, so that the first halving does not allocate either)
   std::vector<Vec6> wrench;      // scratch per body (force, torque), world
+  std::vector<Vec6> kick_sum;    // the half kick's impulses from the child joints' guesses, summed into each
+                                 // parent (N s, N m s, world); zero between kicks (each entry reset once read)
   std::vector<Vec3> rows;        // scratch per joint
-  std::vector<Vec6> correction;  // solver output per body
+  std::vector<Vec6> correction;  // solver output per body (contact response, tests)
   std::vector<Vec3> impulse;     // joint impulses of the last step (N s), for the warm start
   std::vector<Vec3> step_impulse;  // joint impulses being accumulated in this step
   std::vector<Mat3> drift_map;   // per body: kicked angular velocity -> drift angular velocity
@@ -259,69 +262,99 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   return true;
 }
 
-// One pass of rattle()'s drift over the bodies (parents before children), from state_ into work.next:
-//  - first the last Newton correction (work.correction, from the tree solve of the joint gaps), added
-//    to the half-step velocities (kVelocity, accumulating the joint impulses work.rows into the step's)
-//    or to the pseudo-velocities (kPseudo);
-//  - then the drift x' = x + h v, q' = exp(h w_m) q (plus h times the pseudo-velocity if with_pseudo),
-//    the rotation matrices and lever arms at the new pose, and the joint gaps divided by h into
-//    work.rows, ready for the next solve.
+namespace {
+
+// The drift of body i from `now` into work.next (its parent's must be done): x' = x + h v,
+// q' = exp(h w_m) q with w_m = drift_map w (plus h times the pseudo-velocity if with_pseudo), the rotation
+// matrix and lever arms at the new pose (kept for the factorization), and the joint gap divided by h into
+// work.rows[i], ready for the next solve. Returns the gap's largest coordinate (m; NaN stays NaN).
+[[gnu::always_inline]] inline double drift_body(const Model& model, StepWorkspace& work, const State& now, int i, double h,
+                         bool with_pseudo) {
+  State& next = work.next;
+  Vec3 position = now.position[i] + h * next.velocity[i];
+  Quat orientation = turned(h * (work.drift_map[i] * next.angular[i]), now.orientation[i]);
+  if (with_pseudo) {
+    position += h * work.pseudo[i].head<3>();
+    orientation = turned(h * work.pseudo[i].tail<3>(), orientation);
+  }
+  // The arms come from the local matrix, not from the array it is stored to (reading a just-written
+  // matrix back stalls on store forwarding).
+  const Mat3 turn = orientation.toRotationMatrix();
+  const Vec3 child_arm = turn * model.joint_in_child[i];
+  const int p = model.parent[i];  // p < i: its rotation and position at the new pose are done
+  const Vec3 parent_arm = work.rotation[p] * model.joint_in_parent[i];
+  const Vec3 gap = (next.position[p] + parent_arm) - (position + child_arm);
+  next.position[i] = position;
+  next.orientation[i] = orientation;
+  work.rotation[i] = turn;
+  work.child_arm[i] = child_arm;
+  work.parent_arm[i] = parent_arm;
+  work.rows[i] = gap * (1.0 / h);
+  return gap.cwiseAbs().maxCoeff();
+}
+
+// The larger of two gaps, NaN if either is (a NaN gap must not be lost).
+inline double widest(double worst, double gap) { return gap > worst || !std::isfinite(gap) ? gap : worst; }
+
+}  // namespace
+
+// A pass of rattle()'s drift over all bodies (drift_body, parents first). The first of a step also forms
+// each body's drift_map (see rattle's step 2) from the kicked velocities, just before drifting it.
 // Returns the largest joint gap (m, per coordinate; NaN stays NaN).
-double Simulation::drift_pass(double h, DriftCorrection correction, bool with_pseudo) {
+double Simulation::drift_pass(double h, bool first_of_step, bool with_pseudo) {
   const int n = model_.count;
-  const std::vector<int>& parent = model_.parent;
+  StepWorkspace& work = *work_;
+  const State& now = state_;
+  const std::vector<Mat3>& inertia = work.solver.world_inertia();
+  double worst = 0;
+  for (int i = 1; i < n; ++i) {
+    if (first_of_step) {
+      // drift_map = I(q_m)^-1 I(q) at the half-way orientation q_m = exp(h w / 2) q.
+      const Quat half = turned(0.5 * h * work.next.angular[i], now.orientation[i]);
+      const Mat3 rot = half.toRotationMatrix();
+      const Mat3 scaled = rot * work.inverse_moments[i].asDiagonal();
+      Mat3 midpoint_inverse_inertia;
+      midpoint_inverse_inertia.noalias() = scaled * rot.transpose();
+      work.drift_map[i].noalias() = midpoint_inverse_inertia * inertia[i];
+    }
+    worst = widest(worst, drift_body(model_, work, now, i, h, with_pseudo));
+  }
+  return worst;
+}
+
+// One Newton correction of rattle()'s drift: the tree solve of the joint gaps in work.rows, whose result
+// each body adds, inside the solve's base-to-tip sweep, to its half-step velocity (kVelocity, with the
+// joint impulses added to the step's) or to its pseudo-velocity (kPseudo) before drifting again
+// (drift_body). Returns the largest joint gap after it (m, per coordinate; NaN stays NaN).
+double Simulation::correct_and_drift(double h, DriftCorrection correction, bool with_pseudo) {
   StepWorkspace& work = *work_;
   const State& now = state_;
   State& next = work.next;
-  std::vector<Vec3>& c = work.rows;
-  const std::vector<Vec6>& du = work.correction;
-  std::vector<Mat3>& rotation = work.rotation;
   double worst = 0;
-  for (int i = 1; i < n; ++i) {
+  ++work.joint_iterations;
+  work.solver.solve_rows_visiting(work.rows, [&](int i, const Vec6& du, const Vec3& impulse) {
     if (correction == DriftCorrection::kVelocity) {
-      next.velocity[i] += du[i].head<3>();
-      next.angular[i] += du[i].tail<3>();
-      work.step_impulse[i] += c[i];
-    } else if (correction == DriftCorrection::kPseudo) {
-      work.pseudo[i] += du[i];
+      next.velocity[i] += du.head<3>();
+      next.angular[i] += du.tail<3>();
+      work.step_impulse[i] += impulse;
+    } else {
+      work.pseudo[i] += du;
     }
-    Vec3 position = now.position[i] + h * next.velocity[i];
-    Quat orientation = turned(h * (work.drift_map[i] * next.angular[i]), now.orientation[i]);
-    if (with_pseudo) {
-      position += h * work.pseudo[i].head<3>();
-      orientation = turned(h * work.pseudo[i].tail<3>(), orientation);
-    }
-    // The arms come from the local matrix, not from the array it is stored to (reading a just-written
-    // matrix back stalls on store forwarding).
-    const Mat3 turn = orientation.toRotationMatrix();
-    const Vec3 child_arm = turn * model_.joint_in_child[i];
-    const int p = parent[i];  // p < i: its rotation and position at the new pose are done
-    const Vec3 parent_arm = rotation[p] * model_.joint_in_parent[i];
-    const Vec3 gap = (next.position[p] + parent_arm) - (position + child_arm);
-    next.position[i] = position;
-    next.orientation[i] = orientation;
-    rotation[i] = turn;
-    work.child_arm[i] = child_arm;
-    work.parent_arm[i] = parent_arm;
-    const double g = gap.cwiseAbs().maxCoeff();
-    worst = g > worst || !std::isfinite(g) ? g : worst;  // a NaN gap stays NaN
-    c[i] = gap * (1.0 / h);
-  }
+    worst = widest(worst, drift_body(model_, work, now, i, h, with_pseudo));
+  });
   return worst;
 }
 
 // rattle()'s step 2b: drift with the pseudo-velocity added and correct the pseudo-velocity (not the real
 // one) until the joints close. False if the Newton iteration gives up; the pose is then left open.
 bool Simulation::push_apart(double h) {
-  StepWorkspace& work = *work_;
   double previous_worst = INFINITY;
+  double worst = drift_pass(h, false, true);
   for (int iteration = 0;; ++iteration) {
-    const double worst = drift_pass(h, iteration > 0 ? DriftCorrection::kPseudo : DriftCorrection::kNone, true);
     if (worst <= kJointTolerance) return true;
     if (newton_gives_up(iteration, worst, previous_worst)) return false;
     previous_worst = worst;
-    work.solver.solve_rows(work.rows, work.correction, nullptr);
-    ++work.joint_iterations;
+    worst = correct_and_drift(h, DriftCorrection::kPseudo, true);
   }
 }
 
@@ -335,15 +368,15 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   const State& now = state_;
   State& next = work.next;
   TreeSolver& solver = work.solver;
-  std::vector<Vec6>& f = work.wrench;
   const std::vector<Vec3>& r = solver.child_arm();    // at the factored pose
   const std::vector<Vec3>& s = solver.parent_arm();
   const std::vector<Mat3>& inertia = solver.world_inertia();
   const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
   // 1. Half kick: applied impulses (h/2) f at the current state plus a guess of the joint impulses P,
-  //    which act on the child as (P, r x P) and on the parent as -(P, s x P). Parents come first
-  //    (parent[i] < i), so f[p] is set before its children subtract from it. The guess, when the last two
+  //    which act on the child as (P, r x P) and on the parent as -(P, s x P). Children come first
+  //    (parent[i] < i, the bodies in decreasing order), so each body's sum is complete when it is kicked
+  //    (one pass: kick_sum collects what the children's guesses give their parents). The guess, when the last two
   //    steps had this length: P = M_n + (P_n - M_n-1), where P_n is the last step's first-kick impulse
   //    and M_n, M_n-1 the second-kick (velocity projection) impulses of the last two steps. M_n acts at
   //    this step's pose, where P will; P_n and M_n-1 both acted at the last step's start, and their
@@ -354,22 +387,22 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   //    scaled to this step's length.
   const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
-  for (int i = 1; i < n; ++i) {
+  std::vector<Vec6>& sum = work.kick_sum;
+  for (int i = n - 1; i >= 1; --i) {
     const Vec3 impulse = predict ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
                                  : Vec3(warm * work.impulse[i]);
     work.step_impulse[i] = impulse;
-    f[i] = (0.5 * h) * applied_wrench(now, i, inertia[i] * now.angular[i]);
-    f[i].head<3>() += impulse;
-    f[i].tail<3>() += r[i].cross(impulse);
+    Vec6 kick = (0.5 * h) * applied_wrench(now, i, inertia[i] * now.angular[i]) + sum[i];
+    sum[i].setZero();
+    kick.head<3>() += impulse;
+    kick.tail<3>() += r[i].cross(impulse);
     const int p = parent[i];
     if (p != 0) {
-      f[p].head<3>() -= impulse;
-      f[p].tail<3>() -= s[i].cross(impulse);
+      sum[p].head<3>() -= impulse;
+      sum[p].tail<3>() -= s[i].cross(impulse);
     }
-  }
-  for (int i = 1; i < n; ++i) {
-    next.velocity[i] = now.velocity[i] + f[i].head<3>() * (1.0 / model_.mass[i]);
-    next.angular[i] = now.angular[i] + inverse_inertia[i] * f[i].tail<3>();
+    next.velocity[i] = now.velocity[i] + kick.head<3>() * (1.0 / model_.mass[i]);
+    next.angular[i] = now.angular[i] + inverse_inertia[i] * kick.tail<3>();
   }
 
   // Collisions: impulses on the half-step velocities for the contacts at the current pose, solved with
@@ -437,7 +470,6 @@ bool Simulation::rattle(double h) {
   TreeSolver& solver = work.solver;
   std::vector<Vec6>& f = work.wrench;
   std::vector<Vec3>& c = work.rows;
-  std::vector<Vec6>& du = work.correction;
   std::vector<Mat3>& rotation = work.rotation;
 
   if (!work.factored) {
@@ -446,7 +478,6 @@ bool Simulation::rattle(double h) {
   }
   const std::vector<Vec3>& r = solver.child_arm();    // at the factored pose
   const std::vector<Vec3>& s = solver.parent_arm();
-  const std::vector<Mat3>& inertia = solver.world_inertia();
   const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
   // 1. The half kick and the contacts. A rejection after a kick that changed some body's turn per step
@@ -466,29 +497,22 @@ bool Simulation::rattle(double h) {
     if (!suspicious || !kick_and_collide(h, false, contact_report, has_pseudo)) return false;
   }
 
-  // The drift turns each body at constant world angular momentum L = I w (a free rigid body). We use
-  // the implicit midpoint of that flow: q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
-  // orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
-  // (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q) turns the
-  // kicked angular velocity (at the current inertia) into w_m, also for the corrections below.
-  for (int i = 1; i < n; ++i) {
-    const Quat half = turned(0.5 * h * next.angular[i], now.orientation[i]);
-    const Mat3 rot = half.toRotationMatrix();
-    const Mat3 scaled = rot * work.inverse_moments[i].asDiagonal();
-    Mat3 midpoint_inverse_inertia;
-    midpoint_inverse_inertia.noalias() = scaled * rot.transpose();
-    work.drift_map[i].noalias() = midpoint_inverse_inertia * inertia[i];
-  }
-
   // 2. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
   //    of the half kick so that every joint closes at the new pose (SHAKE). Newton's method with the
   //    current pose's factorization: solving J du = -C(x')/h moves the joints by -C to first order.
-  //    One pass per iteration (drift_pass): the correction of the last solve (if any), the drift, the
-  //    rotation matrices and lever arms at the new pose (kept for the factorization), the joint gaps.
+  //    The first pass drifts with the kicked velocities; each correction (correct_and_drift) is one tree
+  //    solve whose base-to-tip sweep adds each body's correction and drifts it again at once. A pass
+  //    leaves the rotation matrices and lever arms of the new pose (kept for the factorization) and the
+  //    joint gaps. The drift turns each body at constant world angular momentum L = I w (a free rigid
+  //    body): the implicit midpoint of that flow, q' = exp(h w_m) q with w_m = I(q_m)^-1 L at the half-way
+  //    orientation q_m = exp(h w_m / 2) q, found by one fixed-point pass from the predicted velocity
+  //    (symmetric to O(h^3) per step, so the energy does not drift). drift_map = I(q_m)^-1 I(q), formed by
+  //    the first pass, turns the kicked angular velocity (at the current inertia) into w_m, also for the
+  //    corrections.
   double previous_worst = INFINITY;
   int contact_passes = 0;
-  for (int iteration = 0;; ++iteration) {
-    const double worst = drift_pass(h, iteration > 0 ? DriftCorrection::kVelocity : DriftCorrection::kNone, false);
+  double worst = drift_pass(h, true, false);
+  for (int iteration = 0;; ++iteration) {  // iteration: the corrections since the last plain drift
     if (worst <= kJointTolerance) {
       // The joint impulses changed the velocities after the contacts were solved: if a contact is
       // approaching again, correct it (no new bounce) and close the joints once more.
@@ -497,7 +521,8 @@ bool Simulation::rattle(double h) {
         break;
       ++contact_passes;
       previous_worst = INFINITY;
-      iteration = 0;
+      iteration = -1;
+      worst = drift_pass(h, false, false);
       continue;
     }
     // Not converging (too many iterations, growing or non-finite gaps): give up on this h.
@@ -521,8 +546,7 @@ bool Simulation::rattle(double h) {
       return false;
     }
     previous_worst = worst;
-    solver.solve_rows(c, du, &c);  // c now holds this iteration's joint impulses
-    ++work.joint_iterations;
+    worst = correct_and_drift(h, DriftCorrection::kVelocity, false);
   }
   // 2b. Overlaps: the split impulse's pseudo-velocity moves the bodies apart on top of the drift. It
   //     respects the joints only to first order; the rest is closed here by correcting the
@@ -531,21 +555,21 @@ bool Simulation::rattle(double h) {
   //     velocity of rest / h: kinetic energy from nothing, more the more a step is halved. (On
   //     generated-1023 after a breeze, this alone moved the failure described above from t = 0.6 s to
   //     0.8 s.) If the pass does not close the joints, the overlap is left for the next step.
-  if (has_pseudo && !push_apart(h)) drift_pass(h, DriftCorrection::kNone, false);
+  if (has_pseudo && !push_apart(h)) drift_pass(h, false, false);
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
 
   // 3. Factor at the new pose (also used by the next step), from the rotation matrices and lever arms of
-  //    the last drift pass. Angular velocities follow the new inertia at unchanged angular momentum:
-  //    w' = I'^-1 I w (next.angular holds L = I w across the factorization).
-  for (int i = 1; i < n; ++i) next.angular[i] = inertia[i] * next.angular[i];
+  //    the last drift pass.
   solver.factor(rotation, work.child_arm, work.parent_arm);
 
   // 4. Second half kick with the new pose's forces, and joint impulses that make the velocities tangent
-  //    to the joints at the new pose (RATTLE): M du = (h/2) f' + J'^T mu,  J' (v + du) = 0.
+  //    to the joints at the new pose (RATTLE): M du = (h/2) f' + J'^T mu,  J' (v + du) = 0. Angular
+  //    velocities first follow the new inertia at unchanged angular momentum: w' = I'^-1 I w.
+  const std::vector<Mat3>& old_inertia = solver.previous_world_inertia();
   for (int i = 1; i < n; ++i) {
-    const Vec3 momentum = next.angular[i];
+    const Vec3 momentum = old_inertia[i] * next.angular[i];
     next.angular[i] = inverse_inertia[i] * momentum;
     f[i] = (0.5 * h) * applied_wrench(next, i, momentum);
     const int p = parent[i];  // p < i: its angular velocity is already the new one
@@ -554,13 +578,13 @@ bool Simulation::rattle(double h) {
     c[i] = parent_point - child_point;
   }
   std::swap(work.older_projection, work.projection);
-  solver.solve(f, c, du, &work.projection);
   double sum = 0;
-  for (int i = 1; i < n; ++i) {
-    next.velocity[i] += du[i].head<3>();
-    next.angular[i] += du[i].tail<3>();
+  solver.solve_visiting(f, c, [&](int i, const Vec6& du, const Vec3& impulse) {
+    next.velocity[i] += du.head<3>();
+    next.angular[i] += du.tail<3>();
+    work.projection[i] = impulse;
     sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() + next.orientation[i].w();
-  }
+  });
   work.state_sum = sum;
   next.time = now.time + h;
   std::swap(state_, next);

@@ -8,7 +8,7 @@ namespace aloft {
 namespace {
 
 // m [s]x, column by column ([s]x e_j = s x e_j): 18 products instead of a full 3x3 product's 27.
-Mat3 times_skew(const Mat3& m, const Vec3& s) {
+[[gnu::always_inline]] inline Mat3 times_skew(const Mat3& m, const Vec3& s) {
   Mat3 out;
   out.col(0) = s.z() * m.col(1) - s.y() * m.col(2);
   out.col(1) = s.x() * m.col(2) - s.z() * m.col(0);
@@ -17,7 +17,7 @@ Mat3 times_skew(const Mat3& m, const Vec3& s) {
 }
 
 // [s]x m, row by row.
-Mat3 skew_times(const Vec3& s, const Mat3& m) {
+[[gnu::always_inline]] inline Mat3 skew_times(const Vec3& s, const Mat3& m) {
   Mat3 out;
   out.row(0) = s.y() * m.row(2) - s.z() * m.row(1);
   out.row(1) = s.z() * m.row(0) - s.x() * m.row(2);
@@ -26,7 +26,7 @@ Mat3 skew_times(const Vec3& s, const Mat3& m) {
 }
 
 // R diag(d) R^T (world inertia from principal moments d, or its inverse from 1/d).
-Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
+[[gnu::always_inline]] inline Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
   Mat3 rd = r * d.asDiagonal();
   Mat3 out;
   out.noalias() = rd * r.transpose();
@@ -45,6 +45,7 @@ TreeSolver::TreeSolver(const Model& model)
       child_arm_(n_, Vec3::Zero()),
       parent_arm_(n_, Vec3::Zero()),
       inertia_(n_, Mat3::Zero()),
+      previous_inertia_(n_, Mat3::Zero()),
       inverse_inertia_(n_, Mat3::Zero()),
       sum_a_(n_, Mat3::Zero()),
       sum_b_(n_, Mat3::Zero()),
@@ -56,7 +57,8 @@ TreeSolver::TreeSolver(const Model& model)
       k_inv_(n_, Mat3::Zero()),
       g_(n_, Vec6::Zero()),
       y_(n_, Vec6::Zero()),
-      a_(n_, Vec3::Zero()) {
+      a_(n_, Vec3::Zero()),
+      u_(n_, Vec6::Zero()) {
   for (int i = 1; i < n_; ++i) {
     if (model.parent[i] > 0) leaf_[model.parent[i]] = 0;
     inverse_mass_[i] = 1.0 / model.mass[i];
@@ -87,6 +89,7 @@ void TreeSolver::factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& ch
 // A^T K_i^-1 A with A = [E, -[s_i]x] is [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
 void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
   const std::vector<int>& parent = model_.parent;
+  inertia_.swap(previous_inertia_);  // every entry 1..n-1 is written below
   for (int i = n_ - 1; i >= 1; --i) {
     inertia_[i] = rotate_diagonal(rotation[i], model_.principal_moments[i]);
     inverse_inertia_[i] = rotate_diagonal(rotation[i], inverse_moments_[i]);
@@ -138,22 +141,11 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
   }
 }
 
-void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
-                       std::vector<Vec3>* lambda) {
-  solve_sweeps<true>(&f, c, u, lambda);
-}
-
-void TreeSolver::solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda) {
-  solve_sweeps<false>(nullptr, c, u, lambda);
-}
-
+// Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
+// and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)
 template <bool kWithForces>
-void TreeSolver::solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
-                              std::vector<Vec3>* lambda) {
+void TreeSolver::eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c) {
   const std::vector<int>& parent = model_.parent;
-
-  // Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
-  // and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)
   for (int i = n_ - 1; i >= 1; --i) {
     const Vec3& r = child_arm_[i];
     Vec3 rhs = c[i];
@@ -181,18 +173,27 @@ void TreeSolver::solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3
       g_[p].tail<3>() -= parent_arm_[i].cross(a_[i]);
     }
   }
+}
 
-  // Base to tip: lambda_i = a_i - K_i^-1 J_ip u_p, u_i = y_i + W_i lambda_i.
+template void TreeSolver::eliminate<true>(const std::vector<Vec6>*, const std::vector<Vec3>&);
+template void TreeSolver::eliminate<false>(const std::vector<Vec6>*, const std::vector<Vec3>&);
+
+void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
+                       std::vector<Vec3>* lambda) {
   u[0].setZero();
-  for (int i = 1; i < n_; ++i) {
-    const int p = parent[i];
-    Vec3 lam = a_[i];
-    if (p != 0) {
-      const Vec3 parent_point_velocity = u[p].head<3>() + u[p].tail<3>().cross(parent_arm_[i]);
-      lam += k_inv_[i] * parent_point_velocity;  // J_ip u_p = -(v_p + w_p x s_i)
-    }
-    u[i] = y_[i] + w_[i] * lam;
-    if (lambda) (*lambda)[i] = lam;
+  if (lambda) {
+    solve_visiting(f, c, [&](int i, const Vec6& ui, const Vec3& lam) { u[i] = ui, (*lambda)[i] = lam; });
+  } else {
+    solve_visiting(f, c, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
+  }
+}
+
+void TreeSolver::solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda) {
+  u[0].setZero();
+  if (lambda) {
+    solve_rows_visiting(c, [&](int i, const Vec6& ui, const Vec3& lam) { u[i] = ui, (*lambda)[i] = lam; });
+  } else {
+    solve_rows_visiting(c, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
   }
 }
 

@@ -66,6 +66,21 @@ class TreeSolver {
   // The same with f = 0 (joint rows only), which saves the leaves' work.
   void solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda = nullptr);
 
+  // solve() and solve_rows() handing each body's result to visit(i, u_i, lambda_i) instead of storing
+  // it, for i = 1, 2, ... (parents before children), so that a caller's own per-body pass can run inside
+  // the base-to-tip sweep: one pass over the bodies instead of two, which matters when the arrays
+  // outgrow the caches. `visit` may overwrite c[i] (c is read only by the tip-to-base sweep).
+  template <class Visit>
+  void solve_visiting(const std::vector<Vec6>& f, const std::vector<Vec3>& c, Visit&& visit) {
+    eliminate<true>(&f, c);
+    substitute(visit);
+  }
+  template <class Visit>
+  void solve_rows_visiting(const std::vector<Vec3>& c, Visit&& visit) {
+    eliminate<false>(nullptr, c);
+    substitute(visit);
+  }
+
   // Eliminate three wrench columns (world; rows force then torque) applied at `body_a` (wrench_a) and
   // `body_b` (wrench_b) along the paths to the base, with the last factorization. Either body may be 0
   // (the fixed component: its wrench is ignored) and they may be equal. O(path lengths), no allocation once
@@ -81,13 +96,32 @@ class TreeSolver {
   const std::vector<Vec3>& parent_arm() const { return parent_arm_; }
   // World inertia tensors and their inverses at the factored pose.
   const std::vector<Mat3>& world_inertia() const { return inertia_; }
+  // The world inertia tensors at the pose factored before the last one (what world_inertia() returned
+  // until the last factor()).
+  const std::vector<Mat3>& previous_world_inertia() const { return previous_inertia_; }
   const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
 
  private:
   void factor_blocks(const std::vector<Mat3>& rotation);
+  // Tip to base: y_i = D_i^-1 g_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
-  void solve_sweeps(const std::vector<Vec6>* f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
-                    std::vector<Vec3>* lambda);
+  void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
+  // Base to tip: lambda_i = a_i - K_i^-1 J_ip u_p, u_i = y_i + W_i lambda_i, handed to visit.
+  template <class Visit>
+  void substitute(Visit& visit) {
+    const std::vector<int>& parent = model_.parent;
+    for (int i = 1; i < n_; ++i) {
+      const int p = parent[i];
+      Vec3 lam = a_[i];
+      if (p != 0) {
+        const Vec3 parent_point_velocity = u_[p].head<3>() + u_[p].tail<3>().cross(parent_arm_[i]);
+        lam += k_inv_[i] * parent_point_velocity;  // J_ip u_p = -(v_p + w_p x s_i)
+      }
+      const Vec6 u = y_[i] + w_[i] * lam;
+      u_[i] = u;
+      visit(i, u, lam);
+    }
+  }
 
   const Model& model_;
   int n_;
@@ -98,6 +132,7 @@ class TreeSolver {
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
+  std::vector<Mat3> previous_inertia_;  // I_i, world, at the pose factored before
   std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
   // D_i = [m E + A'; B; B^T I_i + C'] is accumulated from the children's joints in 3x3 blocks during the
   // tip-to-base sweep (A', B, C' below, reset to zero once used), then inverted through the Schur
@@ -116,6 +151,7 @@ class TreeSolver {
   std::vector<Vec6> g_;             // solve scratch: what the children's joints add to f (zero between solves)
   std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
   std::vector<Vec3> a_;             // solve scratch: joint terms
+  std::vector<Vec6> u_;             // solve scratch: the solution (u_[0] = 0: the fixed component)
 };
 
 // The symmetric KKT matrix H = [M J^T; J 0] written out densely (moving bodies 1..n-1 as 6-blocks, then
