@@ -311,10 +311,7 @@ double Simulation::drift_pass(double h, bool first_of_step, bool with_pseudo) {
     if (first_of_step) {
       // drift_map = I(q_m)^-1 I(q) at the half-way orientation q_m = exp(h w / 2) q.
       const Quat half = turned(0.5 * h * work.next.angular[i], now.orientation[i]);
-      const Mat3 rot = half.toRotationMatrix();
-      const Mat3 scaled = rot * work.inverse_moments[i].asDiagonal();
-      Mat3 midpoint_inverse_inertia;
-      midpoint_inverse_inertia.noalias() = scaled * rot.transpose();
+      const Mat3 midpoint_inverse_inertia = rotate_diagonal(half.toRotationMatrix(), work.inverse_moments[i]);
       work.drift_map[i].noalias() = midpoint_inverse_inertia * inertia[i];
     }
     worst = widest(worst, drift_body(model_, work, now, i, h, with_pseudo));

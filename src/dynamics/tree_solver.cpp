@@ -25,11 +25,24 @@ namespace {
   return out;
 }
 
-// R diag(d) R^T (world inertia from principal moments d, or its inverse from 1/d).
-[[gnu::always_inline]] inline Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
-  Mat3 rd = r * d.asDiagonal();
+// The inverse of a symmetric 3x3 matrix from the upper triangle of m, by its cofactors (6 of them: the
+// inverse is symmetric too). For the positive definite blocks of the factorization (A, S, K): their
+// determinants are far from zero (a mass, a moment of inertia and a lever arm's square set their scale).
+[[gnu::always_inline]] inline Mat3 symmetric_inverse(const Mat3& m) {
+  const double c00 = m(1, 1) * m(2, 2) - m(1, 2) * m(1, 2);
+  const double c01 = m(0, 2) * m(1, 2) - m(0, 1) * m(2, 2);
+  const double c02 = m(0, 1) * m(1, 2) - m(0, 2) * m(1, 1);
+  const double c11 = m(0, 0) * m(2, 2) - m(0, 2) * m(0, 2);
+  const double c12 = m(0, 1) * m(0, 2) - m(0, 0) * m(1, 2);
+  const double c22 = m(0, 0) * m(1, 1) - m(0, 1) * m(0, 1);
+  const double inverse_det = 1.0 / (m(0, 0) * c00 + m(0, 1) * c01 + m(0, 2) * c02);
   Mat3 out;
-  out.noalias() = rd * r.transpose();
+  out(0, 0) = c00 * inverse_det;
+  out(1, 1) = c11 * inverse_det;
+  out(2, 2) = c22 * inverse_det;
+  out(0, 1) = out(1, 0) = c01 * inverse_det;
+  out(0, 2) = out(2, 0) = c02 * inverse_det;
+  out(1, 2) = out(2, 1) = c12 * inverse_det;
   return out;
 }
 
@@ -108,9 +121,9 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
       Mat3 a = sum_a_[i];
       a.diagonal().array() += model_.mass[i];
       const Mat3& b = sum_b_[i];
-      const Mat3 a_inv = a.inverse();
+      const Mat3 a_inv = symmetric_inverse(a);
       const Mat3 t = a_inv * b;
-      const Mat3 s_inv = (inertia_[i] + sum_c_[i] - b.transpose() * t).inverse();
+      const Mat3 s_inv = symmetric_inverse(inertia_[i] + sum_c_[i] - b.transpose() * t);
       Mat3 z = -t.transpose();
       z(0, 1) -= r.z();
       z(0, 2) += r.y();
@@ -129,7 +142,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
       sum_b_[i].setZero();
       sum_c_[i].setZero();
     }
-    const Mat3 k_inv = k.inverse();
+    const Mat3 k_inv = symmetric_inverse(k);
     k_inv_[i] = k_inv;
     const int p = parent[i];
     if (p != 0) {

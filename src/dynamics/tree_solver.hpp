@@ -30,6 +30,14 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat63 = Eigen::Matrix<double, 6, 3>;
 
+// R diag(d) R^T (world inertia from principal moments d, or its inverse from 1/d).
+[[gnu::always_inline]] inline Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
+  const Mat3 rd = r * d.asDiagonal();
+  Mat3 out;
+  out.noalias() = rd * r.transpose();
+  return out;
+}
+
 // The non-zero part of L^-1 [F; 0] for three wrench columns F applied at one or two bodies, where
 // H = L D L^T is TreeSolver's factorization: only the body and joint nodes on the paths from those bodies
 // to the base are non-zero (eliminating a node touches only its parent). Entries are stored per node,
