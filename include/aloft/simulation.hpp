@@ -97,6 +97,10 @@ class Simulation {
   long long step_count() const { return steps_; }
   // How many times a step had to be halved because the motion was too fast for it.
   long long subdivisions() const;
+  // How many (sub)steps were tried and rejected as too long for the motion, each at the cost of a kick
+  // (and, with collisions on, a detection). A step starts at the subdivision the last one needed, so
+  // this stays well below subdivisions() while the motion stays fast.
+  long long rejected_substeps() const;
   // How many Newton corrections (one tree solve each) the joint impulses needed, over all steps; a step
   // costs this plus one solve for the velocity projection.
   long long joint_iterations() const;

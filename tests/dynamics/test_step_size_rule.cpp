@@ -250,5 +250,27 @@ TEST(StepSizeRule, GenericFastTumblerIsHalvedAndStaysAccurate) {
   expect_within_bounds(r, tolerance, r.steps + r.halvings);
 }
 
+TEST(StepSizeRule, AStepStartsAsDeepAsTheLastOneHadToGo) {
+  // The 1 : 2 : 3 body tumbling at 300 rad/s (0.3 rad per 1 ms step) needs its steps divided several
+  // times. Trying the whole step and every coarser division first, each rejected, costs as many rejected
+  // attempts per step as the first step shows (2^d - 1 for a uniform depth d). Starting where the last
+  // step had to go leaves only the occasional try one level coarser (every fifth step: 2^(d-1)
+  // rejections, a quarter to a half of 2^d - 1 for d >= 2, so under a quarter of the old count over
+  // 99 steps means that most steps reject nothing).
+  const Model model = free_body(kGenericMoments);
+  Simulation sim(model, spinning(model, Vec3(210, 150, -150)));
+  ASSERT_TRUE(sim.step());
+  const long long first = sim.rejected_substeps();
+  const long long first_halvings = sim.subdivisions();
+  ASSERT_GE(first, 3) << "the step should need at least two halvings";
+  for (int k = 0; k < 99; ++k) ASSERT_TRUE(sim.step());
+  const long long later = sim.rejected_substeps() - first;
+  std::printf("tumbler at 300 rad/s: %lld rejected in the first step, %lld in the next 99 (%lld halvings)\n",
+              first, later, sim.subdivisions() - first_halvings);
+  EXPECT_LT(later, 99 * first / 4);
+  // Still as finely divided as the motion needs: at least as many substeps per step as the first had.
+  EXPECT_GE(sim.subdivisions() - first_halvings, 99 * first_halvings * 3 / 4);
+}
+
 }  // namespace
 }  // namespace aloft
