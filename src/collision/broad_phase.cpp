@@ -24,16 +24,28 @@ void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
     for (; j > 0 && before(v, order_[j - 1]); --j) order_[j] = order_[j - 1];
     order_[j] = v;
   }
-  overlaps.clear();
+  // The boxes copied in sweep order, their coordinates permuted so that the sweep axis comes first, so
+  // that the scan below reads memory in order with fixed offsets: with long boxes (a bar across a mobile
+  // overlaps many others along any axis) most of the time goes into rejecting pairs, 19 for each overlap
+  // on generated-1023 swinging. The rejection is branch-free (which side fails is unpredictable).
+  const int u = (axis_ + 1) % 3, w = (axis_ + 2) % 3;  // the other two axes
+  sorted_.resize(order_.size());
   for (std::size_t k = 0; k < order_.size(); ++k) {
-    const int i = order_[k];
-    const WorldBox& bi = boxes_[i];
-    for (std::size_t m = k + 1; m < order_.size(); ++m) {
-      const int j = order_[m];
-      const WorldBox& bj = boxes_[j];
-      if (bj.low[axis_] > bi.high[axis_]) break;
-      if ((bi.low.array() > bj.high.array()).any() || (bj.low.array() > bi.high.array()).any()) continue;
-      overlaps.emplace_back(std::min(i, j), std::max(i, j));
+    const WorldBox& b = boxes_[order_[k]];
+    sorted_[k] = {{b.low[axis_], b.low[u], b.low[w]}, {b.high[axis_], b.high[u], b.high[w]}, order_[k]};
+  }
+  overlaps.clear();
+  const SortedBox* box = sorted_.data();     // (not re-read through the vector after each emplace_back,
+  const std::size_t count = sorted_.size();  // which may alias it)
+  for (std::size_t k = 0; k < count; ++k) {
+    const SortedBox bi = box[k];
+    for (std::size_t m = k + 1; m < count; ++m) {
+      const SortedBox& bj = box[m];
+      if (bj.low[0] > bi.high[0]) break;
+      const bool apart = (bi.low[1] > bj.high[1]) | (bj.low[1] > bi.high[1]) | (bi.low[2] > bj.high[2]) |
+                         (bj.low[2] > bi.high[2]);
+      if (apart) continue;
+      overlaps.emplace_back(std::min(bi.component, bj.component), std::max(bi.component, bj.component));
     }
   }
   std::sort(overlaps.begin(), overlaps.end());

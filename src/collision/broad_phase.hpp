@@ -36,6 +36,11 @@ class BroadPhase {
   int axis_ = 0;
   std::vector<int> order_;       // members, sorted by low end along axis_ (kept between calls)
   std::vector<WorldBox> boxes_;  // by component
+  struct SortedBox {
+    double low[3], high[3];  // world, m, axes permuted: the sweep axis, then the next two (cyclically)
+    int component;
+  };
+  std::vector<SortedBox> sorted_;  // sweep scratch: the members' boxes in order_ (sized once)
 };
 
 // The world axis (0, 1, 2) along which the points spread most: the best sweep axis.
