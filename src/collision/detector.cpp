@@ -69,6 +69,7 @@ struct CollisionDetector::Impl {
   std::vector<double> odometer;
   bool placed_before = false;
   std::vector<DistanceBound> bounds;  // size a power of two
+  bool coherence = true;              // skip pairs by the remembered distances (set_coherence)
   std::uint64_t max_pieces = 1;       // pieces of the component with the most
 
   // Per-call scratch, indexed by component (sized once).
@@ -76,7 +77,11 @@ struct CollisionDetector::Impl {
   std::vector<double> margin;      // the component's own speculative margin, m
   std::vector<std::pair<int, int>> overlaps;
   std::vector<Vec3> piece_center;  // world centres of a's pieces for the current pair
-  std::vector<PieceContact> found;
+  struct Found {
+    PieceContact contact;
+    double reach_a, reach_b;  // of the two pieces (ConvexPiece::reach)
+  };
+  std::vector<Found> found;
 
   Impl(const Model& model, std::vector<ComponentGeometry> g)
       : geometry(std::move(g)), filter(model, geometry), pairs(internal::prune_pairs(model, geometry, filter)) {}
@@ -130,24 +135,29 @@ struct CollisionDetector::Impl {
             ((static_cast<std::uint64_t>(a) * geometry.size() + static_cast<std::uint64_t>(b)) * max_pieces + k) *
                 max_pieces + l;
         DistanceBound& bound = bounds[slot(key)];
-        if (bound.key == key) {
+        if (coherence && bound.key == key) {
           const double apart = bound.distance - (odometer[a] - bound.odometer_a) - (odometer[b] - bound.odometer_b);
           if (apart - kCoherenceRelativeSlack * bound.distance - kCoherenceSlack > pair_margin) continue;
         }
         if (internal::piece_contact(x, pose[a], y, pose[b], pair_margin, c)) {
-          found.push_back(c);
+          found.push_back({c, x.reach, y.reach});
           bound.key = ~std::uint64_t{0};
         } else {
           bound = {key, c.distance, odometer[a], odometer[b]};
         }
       }
     }
+    // Every contact of the pair carries the largest reach of all the pieces found near each other,
+    // including any the cut below drops (their travel must be bounded too).
+    double reach_a = 0, reach_b = 0;
+    for (const Found& f : found) reach_a = std::max(reach_a, f.reach_a), reach_b = std::max(reach_b, f.reach_b);
     if (found.size() > kMaxContactsPerPair) {
       std::stable_sort(found.begin(), found.end(),
-                       [](const PieceContact& p, const PieceContact& q) { return p.distance < q.distance; });
+                       [](const Found& p, const Found& q) { return p.contact.distance < q.contact.distance; });
       found.resize(kMaxContactsPerPair);
     }
-    for (const PieceContact& f : found) contacts.push_back({a, b, f.point, f.normal, f.distance});
+    for (const Found& f : found)
+      contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b});
   }
 };
 
@@ -182,6 +192,8 @@ CollisionDetector& CollisionDetector::operator=(CollisionDetector&&) noexcept = 
 const CollisionPairs& CollisionDetector::pairs() const { return impl_->pairs; }
 
 double CollisionDetector::reach(int component) const { return impl_->geometry[component].reach; }
+
+void CollisionDetector::set_coherence(bool on) { impl_->coherence = on; }
 
 void CollisionDetector::find_contacts(const State& state, double step, double base_margin,
                                       std::vector<Contact>& contacts) {

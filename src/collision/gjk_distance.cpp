@@ -163,6 +163,8 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
       return r;
     }
     const Vertex x = support(a, pa, b, pb, v);
+    // Every point p of a - b has p.v >= x.w.v (x.w is the support against v).
+    r.lower = std::max(r.lower, v.dot(x.w) / std::sqrt(vv));
     // No progress: v is (to a relative 1e-12 of |v|^2) the closest point of A - B.
     if (vv - v.dot(x.w) <= 1e-12 * vv) break;
     bool repeated = false;

@@ -13,6 +13,11 @@ struct GjkResult {
   Vec3 on_a = Vec3::Zero();      // closest point on a, world (when !overlap)
   Vec3 on_b = Vec3::Zero();      // closest point on b, world
   double distance = 0;           // |on_a - on_b|, m
+  // A certified lower bound of the distance (m): the largest separation along a search direction v
+  // seen, (support of a - b against v) . v / |v|. Equal to `distance` to a relative 1e-12 when GJK
+  // converged; below it when GJK stopped at its iteration limit, as it can on a wire's round side lying
+  // along a plate or another wire (seen: 2.01 mm estimated, 1.57 mm certain, after 64 iterations).
+  double lower = 0;
 };
 
 GjkResult gjk_distance(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b);

@@ -40,8 +40,8 @@ bool cylinder_cylinder_sides(const Vec3& from_a, const Vec3& to_a, double ra, co
 
 // Support-function contact: GJK distance when apart, libccd's EPA when overlapping. True, with `out`,
 // when the signed distance is below `margin` (> 0). When false, out.distance is a lower bound of the
-// signed distance to within GJK's relative 1e-6 (>= margin when the pieces were measured apart; 0 when
-// nothing is known).
+// signed distance (GJK's certified bound, GjkResult::lower; >= margin when the pieces were measured
+// apart; 0 when nothing is known).
 bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                  double margin, PieceContact& out);
 

@@ -262,10 +262,15 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   // limit too.
   for (std::size_t i = 1; i < angular.size(); ++i)
     if (h * angular[i].norm() > kOldTurnLimit) return false;
+  // The travel of the pieces in contact: |v| + |w| times the piece's reach from the centre of mass (a
+  // plate's, not its thread's up to the joint). Any other piece of the pair that could come near within
+  // the step is within the detection margin, which the component's whole reach sets, so it is a contact
+  // of its own, checked here too.
   for (const Contact& c : work.contacts) {
-    for (int i : {c.a, c.b}) {
+    for (const auto& [i, piece_reach] : {std::pair{c.a, c.reach_a}, std::pair{c.b, c.reach_b}}) {
       if (i == 0) continue;
-      const double speed = velocity[i].norm() + angular[i].norm() * work.detector->reach(i);
+      const double reach = std::min(work.detector->reach(i), piece_reach);
+      const double speed = velocity[i].norm() + angular[i].norm() * reach;
       if (h * speed > kMaxContactTravel) return false;
     }
   }

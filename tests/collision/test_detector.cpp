@@ -95,40 +95,45 @@ TEST(Detector, DeterministicOnTheSteelFishSwung) {
 
 // The detector remembers the distances of piece pairs it measured apart and skips them while what the
 // components moved since cannot have closed the gap (detector.cpp, "Coherence"). That must never change
-// the answer: along 10 s of the Steel Fish shaken hard (pieces knocking, spinning, sliding), a detector
-// that has seen every step gives, bit for bit, the contacts of a fresh one that has seen none.
+// the answer: along 60 s of the Steel Fish shaken hard (pieces knocking, spinning, sliding), a detector
+// that remembers gives, bit for bit at every step, the contacts of one that does not. (It once did not:
+// GJK's distance estimate, above the truth where GJK stopped at its iteration limit on a wire lying along
+// a plate, was remembered as a lower bound. Checked every 20 ms along 10 s, as this test did then, that
+// went unseen; at every step it fails within the first 60 s.)
 TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
   const Model m = load_mobile(std::string(ALOFT_SOURCE_DIR) + "/mobiles/steel-fish.json");
   Simulation sim(m);
-  CollisionDetector steady(m);
+  CollisionDetector steady(m), forgetful(m);
+  forgetful.set_coherence(false);
   std::mt19937 rng(3);
   std::normal_distribution<double> g;
   std::vector<Contact> remembered, fresh_contacts;
-  int compared = 0, with_contacts = 0;
-  for (int step = 0; step < 10000; ++step) {
+#ifdef ALOFT_SANITIZED
+  const int steps = 10000;  // 10 s: the sanitizers are ten times slower
+#else
+  const int steps = 60000;
+#endif
+  int with_contacts = 0;
+  for (int step = 0; step < steps; ++step) {
     if (step % 50 == 0) {
       const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));  // as in the shaken Steel Fish test
       for (int i = 1; i < m.count; ++i) sim.loads().force[i] = m.mass[i] * jerk;
     }
     ASSERT_TRUE(sim.step()) << sim.failure()->message;
     steady.find_contacts(sim.state(), 0.001, 5e-4, remembered);
-    if (step % 20 != 0) continue;
-    CollisionDetector fresh(m);
-    fresh.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
-    ++compared;
+    forgetful.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
     with_contacts += !fresh_contacts.empty();
     ASSERT_EQ(remembered.size(), fresh_contacts.size()) << "step " << step;
     for (std::size_t k = 0; k < remembered.size(); ++k) {
-      EXPECT_EQ(remembered[k].a, fresh_contacts[k].a);
-      EXPECT_EQ(remembered[k].b, fresh_contacts[k].b);
-      EXPECT_EQ(remembered[k].distance, fresh_contacts[k].distance);
-      EXPECT_EQ(remembered[k].normal, fresh_contacts[k].normal);
-      EXPECT_EQ(remembered[k].point, fresh_contacts[k].point);
+      ASSERT_EQ(remembered[k].a, fresh_contacts[k].a) << "step " << step;
+      ASSERT_EQ(remembered[k].b, fresh_contacts[k].b) << "step " << step;
+      ASSERT_EQ(remembered[k].distance, fresh_contacts[k].distance) << "step " << step;
+      ASSERT_EQ(remembered[k].normal, fresh_contacts[k].normal) << "step " << step;
+      ASSERT_EQ(remembered[k].point, fresh_contacts[k].point) << "step " << step;
     }
   }
-  std::printf("compared %d, with contacts %d\n", compared, with_contacts);
-  EXPECT_EQ(compared, 500);
-  EXPECT_GT(with_contacts, 20) << "the shaking should bring pieces within the margin";
+  std::printf("%d steps compared, %d with contacts\n", steps, with_contacts);
+  EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
 }
 
 }  // namespace
