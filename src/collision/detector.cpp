@@ -38,8 +38,9 @@ namespace aloft {
 
 namespace {
 constexpr std::size_t kMaxContactsPerPair = 4;
-// The error of a measured distance that is not a contact (m, relative and absolute): GJK stops within a
-// relative 1e-6 on round supports (gjk_distance.cpp), the closed forms at rounding.
+// The error of a measured distance that is not a contact (m, relative and absolute), a margin of safety
+// on top of bounds that are already certified: GJK's lower bound (GjkResult::lower), the closed forms'
+// distances at rounding.
 constexpr double kCoherenceRelativeSlack = 1e-6;
 constexpr double kCoherenceSlack = 1e-9;
 
