@@ -38,10 +38,9 @@ ContactResponse::ContactResponse(const Model& model)
     : model_(model),
       wrench_(model.count, Vec6::Zero()),
       zero_rows_(model.count, Vec3::Zero()),
-      du_(model.count, Vec6::Zero()),
-      lambda_(model.count, Vec3::Zero()) {}
+      du_(model.count, Vec6::Zero()) {}
 
-void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P, bool lambda) {
+void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
   const int m = static_cast<int>(contacts.size());
   for (int k = 0; k < m; ++k) {
     const Vec3 impulse = basis_[k] * P.segment<3>(3 * k);
@@ -54,7 +53,7 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   // The solver ignores body 0 (fixed) and keeps every joint's velocity constraint (c = 0).
   wrench_[0].setZero();
   // (Only the bodies touched above are non-zero; reset them after the solve.)
-  solver_->solve(wrench_, zero_rows_, du_, lambda ? &lambda_ : nullptr);
+  solver_->solve(wrench_, zero_rows_, du_);
   for (const Contact& c : contacts) {
     wrench_[c.a].setZero();
     wrench_[c.b].setZero();
@@ -203,13 +202,11 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
 
   // Apply: one tree solve with G^T P gives every body's velocity change and the joint impulses.
   if (report.active > 0) {
-    respond(contacts, P_, true);
+    respond(contacts, P_);
     for (int i = 1; i < model_.count; ++i) {
       velocity[i] += du_[i].head<3>();
       angular[i] += du_[i].tail<3>();
     }
-  } else {
-    std::fill(lambda_.begin(), lambda_.end(), Vec3::Zero());
   }
 
   // Split impulse: a frictionless pseudo-velocity that removes a part of each overlap beyond the slop.
@@ -225,7 +222,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   if (penetrating) {
     Eigen::VectorXd P;
     solve_frictionless(m, Eigen::VectorXd::Zero(m), target, P);
-    respond(contacts, P, false);
+    respond(contacts, P);
     for (int i = 0; i < model_.count; ++i) pseudo[i] = i == 0 ? Vec6::Zero() : du_[i];
     has_pseudo = true;
   }
@@ -246,7 +243,7 @@ bool ContactResponse::correct(double h, std::vector<Vec3>& velocity, std::vector
   }
   if (!needed) return false;
   solve_contact_law(K_, u_, rows_, P_);
-  respond(contacts, P_, false);
+  respond(contacts, P_);
   for (int i = 1; i < model_.count; ++i) {
     velocity[i] += du_[i].head<3>();
     angular[i] += du_[i].tail<3>();

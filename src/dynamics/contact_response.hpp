@@ -65,9 +65,9 @@ class ContactResponse {
   explicit ContactResponse(const Model& model);
 
   // Resolve `contacts` (detected at `pose`, the pose `solver` is factored at) against the velocities
-  // `velocity`/`angular` (world, changed in place). joint_impulses() then holds the joint impulses the
-  // contact impulses caused (per joint, N s, on the child). They are not added to the step's joint
-  // impulses used for the next step's warm start: contacts are re-solved every step. `pseudo` (per body: linear m/s, angular rad/s) is
+  // `velocity`/`angular` (world, changed in place). The joint impulses the contact impulses cause are
+  // not added to the step's joint impulses used for the next step's warm start (contacts are re-solved
+  // every step), so they are not kept. `pseudo` (per body: linear m/s, angular rad/s) is
   // set to the penetration-removing pseudo-velocity; `has_pseudo` says whether it is non-zero.
   ContactStepReport resolve(const State& pose, TreeSolver& solver, const std::vector<Contact>& contacts, double h,
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
@@ -92,14 +92,12 @@ class ContactResponse {
   const Eigen::MatrixXd& collision_matrix() const { return K_; }
   const Eigen::VectorXd& contact_velocity() const { return u_; }
   const Eigen::VectorXd& impulses() const { return P_; }
-  const std::vector<Vec3>& joint_impulses() const { return lambda_; }
   // Orthonormal basis (n, t1, t2) of contact k, as matrix columns.
   const Mat3& basis(int k) const { return basis_[k]; }
 
  private:
-  // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_ (and
-  // lambda_ when `lambda` is true).
-  void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P, bool lambda);
+  // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_.
+  void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
   // Frictionless impulses for the m contacts of K_: the normal law (solve_normal_law) on K_'s normal rows
   // and columns, for normal velocities `un` and targets `target` (m each). P: 3m, tangential parts zero.
   void solve_frictionless(int m, const Eigen::VectorXd& un, const Eigen::VectorXd& target, Eigen::VectorXd& P) const;
@@ -117,7 +115,6 @@ class ContactResponse {
   std::vector<Vec6> wrench_;   // per body, zero between uses
   std::vector<Vec3> zero_rows_;
   std::vector<Vec6> du_;
-  std::vector<Vec3> lambda_;
 };
 
 }  // namespace aloft
