@@ -62,7 +62,6 @@ struct StepWorkspace {
         wrench(model.count, Vec6::Zero()),
         kick_sum(model.count, Vec6::Zero()),
         rows(model.count, Vec3::Zero()),
-        correction(model.count, Vec6::Zero()),
         impulse(model.count, Vec3::Zero()),
         step_impulse(model.count, Vec3::Zero()),
         drift_map(model.count, Mat3::Identity()),
@@ -88,7 +87,6 @@ struct StepWorkspace {
   std::vector<Vec6> kick_sum;    // the half kick's impulses from the child joints' guesses, summed into each
                                  // parent (N s, N m s, world); zero between kicks (each entry reset once read)
   std::vector<Vec3> rows;        // scratch per joint
-  std::vector<Vec6> correction;  // solver output per body (contact response, tests)
   std::vector<Vec3> impulse;     // joint impulses of the last step (N s), for the warm start
   std::vector<Vec3> step_impulse;  // joint impulses being accumulated in this step
   std::vector<Mat3> drift_map;   // per body: kicked angular velocity -> drift angular velocity
@@ -157,7 +155,8 @@ inline Quat turned(const Vec3& theta, const Quat& q) {
 // Whether the Newton iteration on the joints should stop trying this h: too many iterations, a
 // non-finite gap, or (from the third pass on) a gap that did not at least halve.
 inline bool newton_gives_up(int iteration, double worst, double previous_worst) {
-  return iteration == kMaxJointIterations || !std::isfinite(worst) || (iteration >= 2 && !(worst < 0.5 * previous_worst));
+  return iteration == kMaxJointIterations || !std::isfinite(worst) ||
+         (iteration >= 2 && !(worst < 0.5 * previous_worst));
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
@@ -283,8 +282,8 @@ namespace {
 // q' = exp(h w_m) q with w_m = drift_map w (plus h times the pseudo-velocity if with_pseudo), the rotation
 // matrix and lever arms at the new pose (kept for the factorization), and the joint gap divided by h into
 // work.rows[i], ready for the next solve. Returns the gap's largest coordinate (m; NaN stays NaN).
-[[gnu::always_inline]] inline double drift_body(const Model& model, StepWorkspace& work, const State& now, int i, double h,
-                         bool with_pseudo) {
+[[gnu::always_inline]] inline double drift_body(const Model& model, StepWorkspace& work, const State& now, int i,
+                                                double h, bool with_pseudo) {
   State& next = work.next;
   Vec3 position = now.position[i] + h * next.velocity[i];
   Quat orientation = turned(h * (work.drift_map[i] * next.angular[i]), now.orientation[i]);
@@ -388,15 +387,15 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   // 1. Half kick: applied impulses (h/2) f at the current state plus a guess of the joint impulses P,
   //    which act on the child as (P, r x P) and on the parent as -(P, s x P). Children come first
   //    (parent[i] < i, the bodies in decreasing order), so each body's sum is complete when it is kicked
-  //    (one pass: kick_sum collects what the children's guesses give their parents). The guess, when the last two
-  //    steps had this length: P = M_n + (P_n - M_n-1), where P_n is the last step's first-kick impulse
-  //    and M_n, M_n-1 the second-kick (velocity projection) impulses of the last two steps. M_n acts at
-  //    this step's pose, where P will; P_n and M_n-1 both acted at the last step's start, and their
-  //    difference (what closing the joints at the end of a drift needs beyond making the velocities
+  //    (one pass: kick_sum collects what the children's guesses give their parents). The guess, when the
+  //    last two steps had this length: P = M_n + (P_n - M_n-1), where P_n is the last step's first-kick
+  //    impulse and M_n, M_n-1 the second-kick (velocity projection) impulses of the last two steps. M_n
+  //    acts at this step's pose, where P will; P_n and M_n-1 both acted at the last step's start, and
+  //    their difference (what closing the joints at the end of a drift needs beyond making the velocities
   //    tangent: the curvature of the joints' paths) changes slowly. Measured against extrapolating P
   //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.14 -> 0.96 on the Steel Fish,
-  //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's P
-  //    scaled to this step's length.
+  //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's
+  //    P scaled to this step's length.
   const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
   std::vector<Vec6>& sum = work.kick_sum;
@@ -492,14 +491,15 @@ bool Simulation::rattle(double h) {
   const std::vector<Vec3>& s = solver.parent_arm();
   const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
-  // 1. The half kick and the contacts. A rejection after a kick that changed some body's turn per step
-  //    by more than kSuspiciousKick is tried once more without the guessed joint impulses: the guess is
-  //    only a starting point for SHAKE, and a wrong one (a force going round a loop that a contact
-  //    closes, which the contact cancels every step while the warm start carries it on, and which the
-  //    extrapolation used until then doubled) must not halve the step down to failure at the finest step, as it did
-  //    for generated-1023 after a breeze (t = 0.6 s; Collisions.CrowdedGeneratedMobileInABreezeKeepsGoing)
-  //    and, in a version without this retry, for the shaken Steel Fish (t = 48 s). Kicked without a
-  //    guess, SHAKE finds the joint impulses afresh, and the loop force is gone.
+  // 1. The half kick and the contacts. A rejection after a kick that changed some body's turn per step by
+  //    more than kSuspiciousKick is tried once more without the guessed joint impulses: the guess is only
+  //    a starting point for SHAKE, and a wrong one (a force going round a loop that a contact closes,
+  //    which the contact cancels every step while the warm start carries it on, and which the
+  //    extrapolation used until then doubled) must not halve the step down to failure at the finest step,
+  //    as it did for generated-1023 after a breeze (t = 0.6 s;
+  //    Collisions.CrowdedGeneratedMobileInABreezeKeepsGoing) and, in a version without this retry, for
+  //    the shaken Steel Fish (t = 48 s). Kicked without a guess, SHAKE finds the joint impulses afresh,
+  //    and the loop force is gone.
   bool has_pseudo = false;
   ContactStepReport contact_report;
   if (!kick_and_collide(h, true, contact_report, has_pseudo)) {

@@ -201,15 +201,6 @@ void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, s
   }
 }
 
-void TreeSolver::solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda) {
-  u[0].setZero();
-  if (lambda) {
-    solve_rows_visiting(c, [&](int i, const Vec6& ui, const Vec3& lam) { u[i] = ui, (*lambda)[i] = lam; });
-  } else {
-    solve_rows_visiting(c, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
-  }
-}
-
 void TreeSolver::eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_b, const Mat63& wrench_b,
                                     PathColumns& out) const {
   const std::vector<int>& parent = model_.parent;

@@ -71,13 +71,11 @@ class TreeSolver {
   // `lambda` may be the same array as `c`.
   void solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
              std::vector<Vec3>* lambda = nullptr);
-  // The same with f = 0 (joint rows only), which saves the leaves' work.
-  void solve_rows(const std::vector<Vec3>& c, std::vector<Vec6>& u, std::vector<Vec3>* lambda = nullptr);
-
-  // solve() and solve_rows() handing each body's result to visit(i, u_i, lambda_i) instead of storing
-  // it, for i = 1, 2, ... (parents before children), so that a caller's own per-body pass can run inside
-  // the base-to-tip sweep: one pass over the bodies instead of two, which matters when the arrays
-  // outgrow the caches. `visit` may overwrite c[i] (c is read only by the tip-to-base sweep).
+  // solve() handing each body's result to visit(i, u_i, lambda_i) instead of storing it, for i = 1, 2,
+  // ... (parents before children), so that a caller's own per-body pass can run inside the base-to-tip
+  // sweep: one pass over the bodies instead of two, which matters when the arrays outgrow the caches.
+  // `visit` may overwrite c[i] (c is read only by the tip-to-base sweep). solve_rows_visiting() is the
+  // same with f = 0 (joint rows only), which saves the leaves' work.
   template <class Visit>
   void solve_visiting(const std::vector<Vec6>& f, const std::vector<Vec3>& c, Visit&& visit) {
     eliminate<true>(&f, c);
