@@ -474,7 +474,6 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
 // factorization untouched, when the joint impulses do not converge (the motion is too fast for h).
 bool Simulation::rattle(double h) {
   const int n = model_.count;
-  const std::vector<int>& parent = model_.parent;
   StepWorkspace& work = *work_;
   const State& now = state_;
   State& next = work.next;
@@ -487,9 +486,6 @@ bool Simulation::rattle(double h) {
     solver.factor(now);
     rotation[0] = now.orientation[0].toRotationMatrix();
   }
-  const std::vector<Vec3>& r = solver.child_arm();    // at the factored pose
-  const std::vector<Vec3>& s = solver.parent_arm();
-  const std::vector<Mat3>& inverse_inertia = solver.world_inverse_inertia();
 
   // 1. The half kick and the contacts. A rejection after a kick that changed some body's turn per step by
   //    more than kSuspiciousKick is tried once more without the guessed joint impulses: the guess is only
@@ -573,27 +569,24 @@ bool Simulation::rattle(double h) {
   work.impulse_step = h;
 
   // 3. Factor at the new pose (also used by the next step), from the rotation matrices and lever arms of
-  //    the last drift pass.
-  solver.factor(rotation, work.child_arm, work.parent_arm);
-
+  //    the last drift pass, and in the same sweep:
   // 4. Second half kick with the new pose's forces, and joint impulses that make the velocities tangent
-  //    to the joints at the new pose (RATTLE): M du = (h/2) f' + J'^T mu,  J' (v + du) = 0. Angular
-  //    velocities first follow the new inertia at unchanged angular momentum: w' = I'^-1 I w.
-  const std::vector<Mat3>& old_inertia = solver.previous_world_inertia();
+  //    to the joints at the new pose (RATTLE): M' v' = M' v + (h/2) f' + J'^T mu,  J' v' = 0, where the
+  //    angular part of M' v is the angular momentum I w of the half-step velocity (unchanged by the
+  //    drift's turn: the free body's). So the tree solve is of the momenta with zero joint rows, and its
+  //    result is the new velocity itself.
+  const std::vector<Mat3>& start_inertia = solver.world_inertia();  // still the step's start pose
   for (int i = 1; i < n; ++i) {
-    const Vec3 momentum = old_inertia[i] * next.angular[i];
-    next.angular[i] = inverse_inertia[i] * momentum;
+    const Vec3 momentum = start_inertia[i] * next.angular[i];
     f[i] = (0.5 * h) * applied_wrench(next, i, momentum);
-    const int p = parent[i];  // p < i: its angular velocity is already the new one
-    const Vec3 child_point = next.velocity[i] + next.angular[i].cross(r[i]);
-    const Vec3 parent_point = next.velocity[p] + next.angular[p].cross(s[i]);
-    c[i] = parent_point - child_point;
+    f[i].head<3>() += model_.mass[i] * next.velocity[i];
+    f[i].tail<3>() += momentum;
   }
   std::swap(work.older_projection, work.projection);
   double sum = 0;
-  solver.solve_visiting(f, c, [&](int i, const Vec6& du, const Vec3& impulse) {
-    next.velocity[i] += du.head<3>();
-    next.angular[i] += du.tail<3>();
+  solver.factor_and_solve(rotation, work.child_arm, work.parent_arm, f, [&](int i, const Vec6& u, const Vec3& impulse) {
+    next.velocity[i] = u.head<3>();
+    next.angular[i] = u.tail<3>();
     work.projection[i] = impulse;
     sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() + next.orientation[i].w();
   });

@@ -7,21 +7,26 @@ namespace aloft {
 
 namespace {
 
-// m [s]x, column by column ([s]x e_j = s x e_j): 18 products instead of a full 3x3 product's 27.
+// m [s]x, column by column ([s]x e_j = s x e_j): 18 products instead of a full 3x3 product's 27. (Written
+// in scalars: Eigen's row and column block assignments are not always inlined.)
 [[gnu::always_inline]] inline Mat3 times_skew(const Mat3& m, const Vec3& s) {
   Mat3 out;
-  out.col(0) = s.z() * m.col(1) - s.y() * m.col(2);
-  out.col(1) = s.x() * m.col(2) - s.z() * m.col(0);
-  out.col(2) = s.y() * m.col(0) - s.x() * m.col(1);
+  for (int r = 0; r < 3; ++r) {
+    out(r, 0) = s.z() * m(r, 1) - s.y() * m(r, 2);
+    out(r, 1) = s.x() * m(r, 2) - s.z() * m(r, 0);
+    out(r, 2) = s.y() * m(r, 0) - s.x() * m(r, 1);
+  }
   return out;
 }
 
 // [s]x m, row by row.
 [[gnu::always_inline]] inline Mat3 skew_times(const Vec3& s, const Mat3& m) {
   Mat3 out;
-  out.row(0) = s.y() * m.row(2) - s.z() * m.row(1);
-  out.row(1) = s.z() * m.row(0) - s.x() * m.row(2);
-  out.row(2) = s.x() * m.row(1) - s.y() * m.row(0);
+  for (int c = 0; c < 3; ++c) {
+    out(0, c) = s.y() * m(2, c) - s.z() * m(1, c);
+    out(1, c) = s.z() * m(0, c) - s.x() * m(2, c);
+    out(2, c) = s.x() * m(1, c) - s.y() * m(0, c);
+  }
   return out;
 }
 
@@ -58,7 +63,6 @@ TreeSolver::TreeSolver(const Model& model)
       child_arm_(n_, Vec3::Zero()),
       parent_arm_(n_, Vec3::Zero()),
       inertia_(n_, Mat3::Zero()),
-      previous_inertia_(n_, Mat3::Zero()),
       inverse_inertia_(n_, Mat3::Zero()),
       sum_a_(n_, Mat3::Zero()),
       sum_b_(n_, Mat3::Zero()),
@@ -87,30 +91,41 @@ void TreeSolver::factor(const State& state) {
     child_arm_[i] = rotation_scratch_[i] * model_.joint_in_child[i];
     parent_arm_[i] = rotation_scratch_[parent[i]] * model_.joint_in_parent[i];
   }
-  factor_blocks(rotation_scratch_);
+  factor_blocks<false>(rotation_scratch_, nullptr);
 }
 
 void TreeSolver::factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
                         std::vector<Vec3>& parent_arm) {
   child_arm_.swap(child_arm);
   parent_arm_.swap(parent_arm);
-  factor_blocks(rotation);
+  factor_blocks<false>(rotation, nullptr);
 }
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
 // (children have larger indices, so they are done), then joint i eliminated into the parent:
 // A^T K_i^-1 A with A = [E, -[s_i]x] is [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
-void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
+// With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
+template <bool kEliminate>
+void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f) {
   const std::vector<int>& parent = model_.parent;
-  inertia_.swap(previous_inertia_);  // every entry 1..n-1 is written below
   for (int i = n_ - 1; i >= 1; --i) {
     inertia_[i] = rotate_diagonal(rotation[i], model_.principal_moments[i]);
-    inverse_inertia_[i] = rotate_diagonal(rotation[i], inverse_moments_[i]);
+    const Mat3 inverse_inertia = rotate_diagonal(rotation[i], inverse_moments_[i]);
+    inverse_inertia_[i] = inverse_inertia;
     const Vec3& r = child_arm_[i];
     Mat3 k;
+    Vec6 y;  // with kEliminate: D_i^-1 g_i
+    if constexpr (kEliminate) {
+      y = g_[i] + (*f)[i];
+      g_[i].setZero();
+    }
     if (leaf_[i]) {
       // D_i = M_i = diag(m E, I): W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
-      const Mat3 w_bottom = times_skew(inverse_inertia_[i], r);
+      if constexpr (kEliminate) {
+        y.head<3>() *= inverse_mass_[i];
+        y.tail<3>() = inverse_inertia * y.tail<3>();
+      }
+      const Mat3 w_bottom = times_skew(inverse_inertia, r);
       w_[i].topRows<3>() = inverse_mass_[i] * Mat3::Identity();
       w_[i].bottomRows<3>() = w_bottom;
       k = -skew_times(r, w_bottom);
@@ -138,6 +153,12 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
       a_inv_[i] = a_inv;
       t_[i] = t;
       s_inv_[i] = s_inv;
+      if constexpr (kEliminate) {
+        const Vec3 g1 = y.head<3>();
+        const Vec3 y2 = s_inv * (y.tail<3>() - t.transpose() * g1);
+        y.head<3>() = a_inv * g1 - t * y2;
+        y.tail<3>() = y2;
+      }
       sum_a_[i].setZero();
       sum_b_[i].setZero();
       sum_c_[i].setZero();
@@ -145,14 +166,27 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation) {
     const Mat3 k_inv = symmetric_inverse(k);
     k_inv_[i] = k_inv;
     const int p = parent[i];
+    Vec3 a;
+    if constexpr (kEliminate) {
+      y_[i] = y;
+      a = k_inv * -(y.head<3>() + y.tail<3>().cross(r));  // a_i = K_i^-1 (0 - J_ii y_i)
+      a_[i] = a;
+    }
     if (p != 0) {
       const Mat3 k_sx = times_skew(k_inv, parent_arm_[i]);
       sum_a_[p] += k_inv;
       sum_b_[p] -= k_sx;
       sum_c_[p] -= skew_times(parent_arm_[i], k_sx);
+      if constexpr (kEliminate) {
+        g_[p].head<3>() -= a;
+        g_[p].tail<3>() -= parent_arm_[i].cross(a);
+      }
     }
   }
 }
+
+template void TreeSolver::factor_blocks<true>(const std::vector<Mat3>&, const std::vector<Vec6>*);
+template void TreeSolver::factor_blocks<false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 
 // Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
 // and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)

@@ -66,6 +66,20 @@ class TreeSolver {
   // over by swapping: the caller gets the previous pose's arrays back, as scratch of the same size.
   void factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm, std::vector<Vec3>& parent_arm);
 
+  // That factorization fused with a solve for the wrenches f and c = 0 (joint velocities held at zero),
+  // handing each body's result to visit(i, u_i, lambda_i) as solve_visiting() does: the solve's
+  // tip-to-base sweep runs inside the factorization's, on the blocks just formed, so the step's velocity
+  // projection costs one pass over the bodies, not two. (With f_i = M_i u_i + impulse, u' is the
+  // velocity that is tangent to the joints at the new pose: what RATTLE's projection needs.)
+  template <class Visit>
+  void factor_and_solve(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
+                        std::vector<Vec3>& parent_arm, const std::vector<Vec6>& f, Visit&& visit) {
+    child_arm_.swap(child_arm);
+    parent_arm_.swap(parent_arm);
+    factor_blocks<true>(rotation, &f);
+    substitute(visit);
+  }
+
   // Solve with the last factorization. f: per body (force N, torque N m), world; c: per joint (3);
   // entries for index 0 are ignored. Writes u (per body; u[0] = 0) and, if given, lambda (per joint).
   // `lambda` may be the same array as `c`.
@@ -102,13 +116,12 @@ class TreeSolver {
   const std::vector<Vec3>& parent_arm() const { return parent_arm_; }
   // World inertia tensors and their inverses at the factored pose.
   const std::vector<Mat3>& world_inertia() const { return inertia_; }
-  // The world inertia tensors at the pose factored before the last one (what world_inertia() returned
-  // until the last factor()).
-  const std::vector<Mat3>& previous_world_inertia() const { return previous_inertia_; }
   const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
 
  private:
-  void factor_blocks(const std::vector<Mat3>& rotation);
+  // The factorization's tip-to-base sweep; with kEliminate also eliminate() for the wrenches *f and c = 0.
+  template <bool kEliminate>
+  void factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f);
   // Tip to base: y_i = D_i^-1 g_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
   void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
@@ -138,7 +151,6 @@ class TreeSolver {
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
-  std::vector<Mat3> previous_inertia_;  // I_i, world, at the pose factored before
   std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
   // D_i = [m E + A'; B; B^T I_i + C'] is accumulated from the children's joints in 3x3 blocks during the
   // tip-to-base sweep (A', B, C' below, reset to zero once used), then inverted through the Schur
