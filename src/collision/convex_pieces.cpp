@@ -70,30 +70,34 @@ void add_plate(int shape, const Plate& plate, std::vector<ConvexPiece>& out) {
     ConvexPiece piece = polytope(shape, std::move(vertices));
     piece.prism_half = half;
     for (int k : part) piece.prism_middle.push_back(plate.to_world(plate.points[k]));
-    // Face normals of the prism: its two caps (the plate's normal) and one per side.
+    // Face normals of the prism: its two caps (the plate's normal) and one per side. Edges: one per side
+    // of the polygon, and the thickness (the plate's normal).
     piece.axes.push_back(plate.normal());
+    piece.edges.push_back(plate.normal());
     for (std::size_t k = 0; k < part.size(); ++k) {
       const Vec3 edge = plate.to_world(plate.points[part[(k + 1) % part.size()]]) - plate.to_world(plate.points[part[k]]);
       const Vec3 side = edge.cross(plate.normal());
       if (side.norm() > 0) piece.axes.push_back(side.normalized());
+      if (edge.norm() > 0) piece.edges.push_back(edge.normalized());
     }
     out.push_back(std::move(piece));
   }
 }
 
-// The face normals of a solid built on the triangle (a, b, c): the triangle's own, and for each edge pq
-// the side face containing that edge and the direction towards(p) (a tetrahedron's apex minus p, or a
-// prism's extrusion).
+// The face normals (piece.axes) and edge directions (piece.edges) of a solid built on the triangle
+// (a, b, c): the triangle's own normal and edges, and for each edge pq the side face containing that
+// edge and the direction towards(p) (a tetrahedron's apex minus p, or a prism's extrusion), which is an
+// edge too.
 template <class Towards>
-std::vector<Vec3> triangle_solid_axes(const Vec3& a, const Vec3& b, const Vec3& c, Towards towards) {
-  std::vector<Vec3> axes;
+void set_triangle_solid_axes(ConvexPiece& piece, const Vec3& a, const Vec3& b, const Vec3& c, Towards towards) {
   const Vec3 n = (b - a).cross(c - a);
-  if (n.norm() > 0) axes.push_back(n.normalized());
+  if (n.norm() > 0) piece.axes.push_back(n.normalized());
   for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
     const Vec3 side = (q - p).cross(towards(p));
-    if (side.norm() > 0) axes.push_back(side.normalized());
+    if (side.norm() > 0) piece.axes.push_back(side.normalized());
+    if ((q - p).norm() > 0) piece.edges.push_back((q - p).normalized());
+    if (towards(p).norm() > 0) piece.edges.push_back(towards(p).normalized());
   }
-  return axes;
 }
 
 void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out) {
@@ -115,11 +119,11 @@ void add_mesh(int shape, const TriangleMesh& mesh, std::vector<ConvexPiece>& out
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     if (star) {
       out.push_back(polytope(shape, {a, b, c, centroid}));
-      out.back().axes = triangle_solid_axes(a, b, c, [&](const Vec3& p) { return Vec3(centroid - p); });
+      set_triangle_solid_axes(out.back(), a, b, c, [&](const Vec3& p) { return Vec3(centroid - p); });
     } else {
       const Vec3 inward = -kShellThickness * (b - a).cross(c - a).normalized();
       out.push_back(polytope(shape, {a, b, c, a + inward, b + inward, c + inward}));
-      out.back().axes = triangle_solid_axes(a, b, c, [&](const Vec3&) { return inward; });
+      set_triangle_solid_axes(out.back(), a, b, c, [&](const Vec3&) { return inward; });
     }
   }
 }
@@ -216,7 +220,10 @@ ComponentGeometry build_component_geometry(const std::vector<BodyShape>& shapes)
                      p.a = w.from;
                      p.b = w.to;
                      p.radius = w.radius;
-                     if ((w.to - w.from).norm() > 0) p.axes.push_back((w.to - w.from).normalized());
+                     if ((w.to - w.from).norm() > 0) {
+                       p.axes.push_back((w.to - w.from).normalized());
+                       p.edges.push_back(p.axes.back());
+                     }
                      g.pieces.push_back(p);
                    },
                    [&](const Box& b) {
@@ -226,7 +233,10 @@ ComponentGeometry build_component_geometry(const std::vector<BodyShape>& shapes)
                        corners.push_back(b.center + b.rotation * (0.5 * b.size.cwiseProduct(sign)));
                      }
                      g.pieces.push_back(polytope(k, std::move(corners)));
-                     for (int axis = 0; axis < 3; ++axis) g.pieces.back().axes.push_back(b.rotation.col(axis));
+                     for (int axis = 0; axis < 3; ++axis) {
+                       g.pieces.back().axes.push_back(b.rotation.col(axis));
+                       g.pieces.back().edges.push_back(b.rotation.col(axis));
+                     }
                    },
                    [&](const Plate& p) { add_plate(k, p, g.pieces); },
                    [&](const Mesh& m) { add_mesh(k, m.mesh, g.pieces); },

@@ -33,6 +33,10 @@ struct ConvexPiece {
   // Directions worth testing as a separating axis (body frame, unit, sign irrelevant): a polytope's face
   // normals, a cylinder's axis. The overlap test checks them besides EPA's answer (gjk_contact.cpp).
   std::vector<Vec3> axes;
+  // The directions of the piece's edges (body frame, unit, sign irrelevant; a cylinder's axis). For two
+  // polytopes, the separating axis is one of the face normals or the cross product of an edge direction
+  // of each (the separating axis theorem), so with these the overlap test's candidates are complete.
+  std::vector<Vec3> edges;
   // A plate's part is a prism: its vertices are mid-plane points p +- prism_half. support() then scans
   // the mid-plane points only (half the vertices): max over p, s of (p + s h).d = max p.d + |h.d|.
   std::vector<Vec3> prism_middle;  // body frame, m (empty: not a prism)

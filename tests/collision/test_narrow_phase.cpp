@@ -299,5 +299,85 @@ TEST(NarrowPhase, SmallOverlapsAreReportedSmall) {
               checked, missed, worst_excess * 1e3);
 }
 
+// The signed distance of two boxes by the separating axis theorem, written out for this test: the
+// largest gap between their corners' projections over the 15 candidate axes (3 face normals of each and
+// the 9 cross products of an edge direction of each). Exact for boxes, shares no code with the narrow
+// phase. Gap along n (b towards a): min over a's corners of a.n - max over b's corners of b.n.
+double box_signed_distance(const Box& a, const Box& b) {
+  auto corners = [](const Box& x) {
+    std::vector<Vec3> out;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 sign((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1);
+      out.push_back(x.center + x.rotation * (0.5 * x.size.cwiseProduct(sign)));
+    }
+    return out;
+  };
+  const std::vector<Vec3> ca = corners(a), cb = corners(b);
+  std::vector<Vec3> axes;
+  for (int i = 0; i < 3; ++i) {
+    axes.push_back(a.rotation.col(i));
+    axes.push_back(b.rotation.col(i));
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 n = a.rotation.col(i).cross(b.rotation.col(j));
+      if (n.norm() > 1e-9) axes.push_back(n.normalized());
+    }
+  }
+  double best = -std::numeric_limits<double>::infinity();
+  for (const Vec3& axis : axes) {
+    for (const Vec3& n : {axis, Vec3(-axis)}) {
+      double low_a = INFINITY, high_b = -INFINITY;
+      for (const Vec3& p : ca) low_a = std::min(low_a, p.dot(n));
+      for (const Vec3& p : cb) high_b = std::max(high_b, p.dot(n));
+      best = std::max(best, low_a - high_b);
+    }
+  }
+  return best;
+}
+
+TEST(NarrowPhase, ThinBoxesCrossingEdgeToEdgeGetTheirExactOverlap) {
+  // Two sheets (boxes 1-2 mm thick) at random angles, overlapping by 0.001-0.1 mm, most of them edge
+  // against edge, asked with speculative margins of 0.5-3 mm as the detector does. For two polytopes the
+  // narrow phase's candidates (EPA's direction, the face normals, the edge cross products) include the
+  // separating axis, so the depth is exact up to round-off: 1e-9 m. EPA on the inflated pieces alone
+  // has settled on a wrong face: in the shaken Steel Fish, a plate of an arm against a fish, 2.57 mm for
+  // a touch of 0.0074 mm (gjk_contact.cpp).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  auto random_rotation = [&] {
+    return Quat(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+  };
+  int checked = 0;
+  double worst = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Box a{Vec3::Zero(), Vec3(0.04 + 0.08 * unit(rng), 0.001 + 0.001 * unit(rng), 0.03 + 0.05 * unit(rng)),
+          random_rotation()};
+    Box b{Vec3::Zero(), Vec3(0.04 + 0.08 * unit(rng), 0.001 + 0.001 * unit(rng), 0.03 + 0.05 * unit(rng)),
+          random_rotation()};
+    // Move b out along a random direction until the overlap is the one wanted (the overlapping offsets
+    // along a ray form an interval from 0: bisection).
+    const Vec3 direction = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const double overlap = std::pow(10.0, -6 + 2 * unit(rng));  // 1e-6 .. 1e-4 m
+    double inside = 0, outside = 1;
+    for (int k = 0; k < 80; ++k) {
+      const double mid = 0.5 * (inside + outside);
+      b.center = mid * direction;
+      (box_signed_distance(a, b) < -overlap ? inside : outside) = mid;
+    }
+    b.center = inside * direction;
+    const double exact = box_signed_distance(a, b);
+    const ConvexPiece pa = pieces_of(a)[0], pb = pieces_of(b)[0];
+    const Pose identity;
+    for (int m = 0; m <= 25; ++m) {
+      const double margin = 5e-4 + 1e-4 * m;
+      PieceContact c;
+      ASSERT_TRUE(piece_contact(pa, identity, pb, identity, margin, c)) << "trial " << trial << " margin " << margin;
+      worst = std::max(worst, std::abs(c.distance - exact));
+      EXPECT_NEAR(c.distance, exact, 1e-9) << "trial " << trial << " margin " << margin;
+      ++checked;
+    }
+  }
+  std::printf("thin boxes edge to edge: %d checked, largest error %.3g m\n", checked, worst);
+}
+
 }  // namespace
 }  // namespace aloft::internal
