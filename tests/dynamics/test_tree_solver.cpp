@@ -76,6 +76,63 @@ TEST(TreeSolver, ChainIsLinearTreeToo) {
   }
 }
 
+TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
+  // The step's fused factorization and solve (c = 0) against the two done apart, on random trees at a
+  // random pose (rotation matrices and arms handed in, as the step does). 1e-12 relative: the same
+  // operations in a different order, so only round-off differs.
+  for (const int count : {2, 9, 40, 200}) {
+    std::srand(count);
+    const Model model = test::random_tree(count, count);
+    State state = rest_state(model);
+    for (int i = 1; i < count; ++i) state.orientation[i] = Quat::UnitRandom();
+    std::vector<Mat3> rotation(count);
+    std::vector<Vec3> child_arm(count, Vec3::Zero()), parent_arm(count, Vec3::Zero());
+    for (int i = 0; i < count; ++i) rotation[i] = state.orientation[i].toRotationMatrix();
+    for (int i = 1; i < count; ++i) {
+      child_arm[i] = rotation[i] * model.joint_in_child[i];
+      parent_arm[i] = rotation[model.parent[i]] * model.joint_in_parent[i];
+    }
+    std::mt19937 rng(count);
+    std::normal_distribution<double> normal;
+    std::vector<Vec6> f(count, Vec6::Zero()), u(count, Vec6::Zero()), fused_u(count, Vec6::Zero());
+    std::vector<Vec3> c(count, Vec3::Zero()), lambda(count, Vec3::Zero()), fused_lambda(count, Vec3::Zero());
+    for (int i = 1; i < count; ++i)
+      for (int k = 0; k < 6; ++k) f[i](k) = normal(rng);
+
+    TreeSolver apart(model);
+    std::vector<Vec3> r1 = child_arm, s1 = parent_arm;
+    apart.factor(rotation, r1, s1);
+    apart.solve(f, c, u, &lambda);
+
+    TreeSolver fused(model);
+    fused.factor(state);  // a first factorization, as the step has one from the step before
+    std::vector<Vec3> r2 = child_arm, s2 = parent_arm;
+    fused.factor_and_solve(rotation, r2, s2, f, [&](int i, const Vec6& ui, const Vec3& lam) {
+      fused_u[i] = ui;
+      fused_lambda[i] = lam;
+    });
+    double scale_u = 0, scale_l = 0, error_u = 0, error_l = 0;
+    for (int i = 1; i < count; ++i) {
+      scale_u = std::max(scale_u, u[i].norm());
+      scale_l = std::max(scale_l, lambda[i].norm());
+      error_u = std::max(error_u, (fused_u[i] - u[i]).norm());
+      error_l = std::max(error_l, (fused_lambda[i] - lambda[i]).norm());
+    }
+    EXPECT_LT(error_u, 1e-12 * scale_u) << count << " components";
+    EXPECT_LT(error_l, 1e-12 * scale_l) << count << " components";
+    // And the factorization left behind is the same: a later solve of joint rows agrees too.
+    for (int i = 1; i < count; ++i) c[i] = Vec3(normal(rng), normal(rng), normal(rng));
+    std::vector<Vec6> zero(count, Vec6::Zero());
+    apart.solve(zero, c, u, &lambda);
+    fused.solve(zero, c, fused_u, &fused_lambda);
+    double scale_rows = 0, error_rows = 0;
+    for (int i = 1; i < count; ++i) {
+      scale_rows = std::max(scale_rows, u[i].norm());
+      error_rows = std::max(error_rows, (fused_u[i] - u[i]).norm());
+    }
+    EXPECT_LT(error_rows, 1e-12 * scale_rows) << count << " components";
+  }
+}
 
 // F1^T H^-1 F2 by full solves: the velocity response u = H^-1 [F2; 0] read against F1's wrenches.
 Mat3 coupling_by_full_solves(const Model& model, TreeSolver& solver, int a1, const Mat63& w1a, int b1,
