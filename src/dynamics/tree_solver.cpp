@@ -81,6 +81,34 @@ TreeSolver::TreeSolver(const Model& model)
     inverse_mass_[i] = 1.0 / model.mass[i];
     inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
   }
+  set_stack_folding(n_ >= kStackFoldingBodies);
+}
+
+// Replays the sweep's stack discipline: going tip to base, a body's children must all have been folded
+// into the stack's top entry when the sweep reaches it, and a body's parent is either the top entry or
+// not on the stack at all.
+bool TreeSolver::stack_folding_possible(const std::vector<int>& parent) {
+  const int n = static_cast<int>(parent.size());
+  std::vector<int> stack;
+  std::vector<char> on_stack(n, 0);
+  for (int i = n - 1; i >= 1; --i) {
+    if (on_stack[i]) {
+      if (stack.back() != i) return false;
+      stack.pop_back();
+      on_stack[i] = 0;
+    }
+    const int p = parent[i];
+    if (p == 0 || (!stack.empty() && stack.back() == p)) continue;
+    if (on_stack[p]) return false;
+    stack.push_back(p);
+    on_stack[p] = 1;
+  }
+  return stack.empty();
+}
+
+void TreeSolver::set_stack_folding(bool on) {
+  stack_folding_ = on && stack_folding_possible(model_.parent);
+  if (stack_folding_ && folded_.empty()) folded_.resize(n_ + 1);
 }
 
 void TreeSolver::factor(const State& state) {
@@ -91,24 +119,28 @@ void TreeSolver::factor(const State& state) {
     child_arm_[i] = rotation_scratch_[i] * model_.joint_in_child[i];
     parent_arm_[i] = rotation_scratch_[parent[i]] * model_.joint_in_parent[i];
   }
-  factor_blocks<false>(rotation_scratch_, nullptr);
+  factor_blocks<false, false>(rotation_scratch_, nullptr);  // arrays: a plain factorization is rare (the first step, a jump)
 }
 
 void TreeSolver::factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
                         std::vector<Vec3>& parent_arm) {
   child_arm_.swap(child_arm);
   parent_arm_.swap(parent_arm);
-  factor_blocks<false>(rotation, nullptr);
+  factor_blocks<false, false>(rotation, nullptr);  // arrays: a plain factorization is rare (the first step, a jump)
 }
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
 // (children have larger indices, so they are done), then joint i eliminated into the parent:
 // A^T K_i^-1 A with A = [E, -[s_i]x] is [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
 // With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
-template <bool kEliminate>
+// With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
+template <bool kEliminate, bool kStack>
 void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f) {
   const std::vector<int>& parent = model_.parent;
+  int top = 0;  // kStack: folded_[1..top] in use
   for (int i = n_ - 1; i >= 1; --i) {
+    // kStack: what i's children folded into it, on top of the stack (an interior body's always is).
+    const Folded* mine = kStack && top > 0 && folded_[top].body == i ? &folded_[top] : nullptr;
     inertia_[i] = rotate_diagonal(rotation[i], model_.principal_moments[i]);
     const Mat3 inverse_inertia = rotate_diagonal(rotation[i], inverse_moments_[i]);
     inverse_inertia_[i] = inverse_inertia;
@@ -116,8 +148,13 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
     Mat3 k;
     Vec6 y;  // with kEliminate: D_i^-1 g_i
     if constexpr (kEliminate) {
-      y = g_[i] + (*f)[i];
-      g_[i].setZero();
+      if constexpr (kStack) {
+        y = (*f)[i];
+        if (mine) y += mine->g;
+      } else {
+        y = g_[i] + (*f)[i];
+        g_[i].setZero();
+      }
     }
     if (leaf_[i]) {
       // D_i = M_i = diag(m E, I): W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
@@ -133,12 +170,16 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
     } else {
       // W_i = D^-1 [E; [r]x]: with Z = [r]x - T^T, W_bottom = S^-1 Z, W_top = A^-1 - T W_bottom, and
       // K_i = W_top - [r]x W_bottom = A^-1 + Z^T S^-1 Z.
-      Mat3 a = sum_a_[i];
+      const Mat3* folded_a = &sum_a_[i];
+      const Mat3* folded_b = &sum_b_[i];
+      const Mat3* folded_c = &sum_c_[i];
+      if constexpr (kStack) folded_a = &mine->a, folded_b = &mine->b, folded_c = &mine->c;
+      Mat3 a = *folded_a;
       a.diagonal().array() += model_.mass[i];
-      const Mat3& b = sum_b_[i];
+      const Mat3& b = *folded_b;
       const Mat3 a_inv = symmetric_inverse(a);
       const Mat3 t = a_inv * b;
-      const Mat3 s_inv = symmetric_inverse(inertia_[i] + sum_c_[i] - b.transpose() * t);
+      const Mat3 s_inv = symmetric_inverse(inertia_[i] + *folded_c - b.transpose() * t);
       Mat3 z = -t.transpose();
       z(0, 1) -= r.z();
       z(0, 2) += r.y();
@@ -159,9 +200,13 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
         y.head<3>() = a_inv * g1 - t * y2;
         y.tail<3>() = y2;
       }
-      sum_a_[i].setZero();
-      sum_b_[i].setZero();
-      sum_c_[i].setZero();
+      if constexpr (kStack) {
+        --top;  // mine is done with (its entry may be reused below)
+      } else {
+        sum_a_[i].setZero();
+        sum_b_[i].setZero();
+        sum_c_[i].setZero();
+      }
     }
     const Mat3 k_inv = symmetric_inverse(k);
     k_inv_[i] = k_inv;
@@ -174,19 +219,45 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
     }
     if (p != 0) {
       const Mat3 k_sx = times_skew(k_inv, parent_arm_[i]);
-      sum_a_[p] += k_inv;
-      sum_b_[p] -= k_sx;
-      sum_c_[p] -= skew_times(parent_arm_[i], k_sx);
-      if constexpr (kEliminate) {
-        g_[p].head<3>() -= a;
-        g_[p].tail<3>() -= parent_arm_[i].cross(a);
+      if constexpr (kStack) {
+        if (top > 0 && folded_[top].body == p) {  // a sibling began p's entry
+          Folded& into = folded_[top];
+          into.a += k_inv;
+          into.b -= k_sx;
+          into.c -= skew_times(parent_arm_[i], k_sx);
+          if constexpr (kEliminate) {
+            into.g.head<3>() -= a;
+            into.g.tail<3>() -= parent_arm_[i].cross(a);
+          }
+        } else {  // the first of p's children the sweep reaches: 0 - x, as the arrays' sums start at 0
+          Folded& into = folded_[++top];
+          into.body = p;
+          into.a = k_inv;
+          into.b = -k_sx;
+          into.c = -skew_times(parent_arm_[i], k_sx);
+          if constexpr (kEliminate) {
+            into.g.head<3>() = -a;
+            into.g.tail<3>() = -parent_arm_[i].cross(a);
+          } else {
+            into.g.setZero();
+          }
+        }
+      } else {
+        sum_a_[p] += k_inv;
+        sum_b_[p] -= k_sx;
+        sum_c_[p] -= skew_times(parent_arm_[i], k_sx);
+        if constexpr (kEliminate) {
+          g_[p].head<3>() -= a;
+          g_[p].tail<3>() -= parent_arm_[i].cross(a);
+        }
       }
     }
   }
 }
 
-template void TreeSolver::factor_blocks<true>(const std::vector<Mat3>&, const std::vector<Vec6>*);
-template void TreeSolver::factor_blocks<false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
+template void TreeSolver::factor_blocks<true, true>(const std::vector<Mat3>&, const std::vector<Vec6>*);
+template void TreeSolver::factor_blocks<true, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
+template void TreeSolver::factor_blocks<false, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 
 // Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
 // and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)

@@ -76,9 +76,29 @@ class TreeSolver {
                         std::vector<Vec3>& parent_arm, const std::vector<Vec6>& f, Visit&& visit) {
     child_arm_.swap(child_arm);
     parent_arm_.swap(parent_arm);
-    factor_blocks<true>(rotation, &f);
+    if (stack_folding_) {
+      factor_blocks<true, true>(rotation, &f);
+    } else {
+      factor_blocks<true, false>(rotation, &f);
+    }
     substitute(visit);
   }
+
+  // How factor_and_solve() carries what a body's child joints fold into it (A', B, C' below, and the
+  // solve's g) to the body: in per-body arrays, or on a stack as deep as the tree (nothing per body is
+  // read or written for it). The stack needs the bodies in depth-first preorder (as compile() orders
+  // them), so that the tip-to-base sweep finishes each subtree before it leaves it; it saves memory
+  // traffic, which pays where the per-body arrays outgrow the caches, and costs a few per cent where they
+  // do not (docs/performance.md, "Folding on a stack"). Default: the stack from kStackFoldingBodies
+  // bodies on, when the order allows it. Results are the same bit for bit either way (same sums in the
+  // same order). The plain factor() (the first step, or after a jump) always uses the arrays: a third
+  // instantiation of the sweep made GCC stop inlining Eigen's 3x3 products in the others (+6%
+  // instructions).
+  static constexpr int kStackFoldingBodies = 4096;
+  static bool stack_folding_possible(const std::vector<int>& parent);
+  bool stack_folding() const { return stack_folding_; }
+  // Choose explicitly (for tests and measurements); the stack only if stack_folding_possible().
+  void set_stack_folding(bool on);
 
   // Solve with the last factorization. f: per body (force N, torque N m), world; c: per joint (3);
   // entries for index 0 are ignored. Writes u (per body; u[0] = 0) and, if given, lambda (per joint).
@@ -120,7 +140,7 @@ class TreeSolver {
 
  private:
   // The factorization's tip-to-base sweep; with kEliminate also eliminate() for the wrenches *f and c = 0.
-  template <bool kEliminate>
+  template <bool kEliminate, bool kStack>
   void factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f);
   // Tip to base: y_i = D_i^-1 g_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
@@ -166,6 +186,15 @@ class TreeSolver {
   std::vector<Mat3> s_inv_;         // S^-1 (symmetric; interior bodies only)
   std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
   std::vector<Mat3> k_inv_;         // K_i^-1
+  // The stack of stack_folding(): one entry per body whose children have begun to fold into it and that
+  // is not done yet (bodies on the path from the sweep's position to the base), at most the tree's depth.
+  struct Folded {
+    int body;
+    Mat3 a, b, c;  // as sum_a_, sum_b_, sum_c_
+    Vec6 g;        // as g_ (the fused solve's)
+  };
+  bool stack_folding_ = false;
+  std::vector<Folded> folded_;      // [1, top] in use during a sweep; sized n_ + 1 once
   std::vector<Vec6> g_;             // solve scratch: what the children's joints add to f (zero between solves)
   std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
   std::vector<Vec3> a_;             // solve scratch: joint terms

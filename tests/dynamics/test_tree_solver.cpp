@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "aloft/generate.hpp"
 #include "dynamics/tree_solver.hpp"
 #include "support/model_builder.hpp"
 
@@ -132,6 +133,68 @@ TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
     }
     EXPECT_LT(error_rows, 1e-12 * scale_rows) << count << " components";
   }
+}
+
+TEST(TreeSolver, FoldingOnAStackGivesTheSameBitsAsTheArrays) {
+  // A generated mobile (compiled: depth-first preorder) of 127 components at a random pose: the fused
+  // factorization and solve, and a later solve of joint rows, with the children's folds carried on the
+  // stack and in the per-body arrays. The same sums in the same order: equal bit for bit.
+  GenerateOptions options;
+  options.components = 127;
+  options.seed = 3;
+  const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-127.json"));
+  ASSERT_TRUE(TreeSolver::stack_folding_possible(model.parent));
+  std::srand(5);
+  State state = rest_state(model);
+  for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
+  std::vector<Mat3> rotation(model.count);
+  for (int i = 0; i < model.count; ++i) rotation[i] = state.orientation[i].toRotationMatrix();
+  std::vector<Vec3> child_arm(model.count, Vec3::Zero()), parent_arm(model.count, Vec3::Zero());
+  for (int i = 1; i < model.count; ++i) {
+    child_arm[i] = rotation[i] * model.joint_in_child[i];
+    parent_arm[i] = rotation[model.parent[i]] * model.joint_in_parent[i];
+  }
+  std::mt19937 rng(9);
+  std::normal_distribution<double> normal;
+  std::vector<Vec6> f(model.count, Vec6::Zero()), zero(model.count, Vec6::Zero());
+  std::vector<Vec3> c(model.count, Vec3::Zero());
+  for (int i = 1; i < model.count; ++i) {
+    for (int k = 0; k < 6; ++k) f[i](k) = normal(rng);
+    c[i] = Vec3(normal(rng), normal(rng), normal(rng));
+  }
+  std::vector<Vec6> fused[2], rows[2];
+  for (const bool stack : {false, true}) {
+    TreeSolver solver(model);
+    solver.set_stack_folding(stack);
+    ASSERT_EQ(solver.stack_folding(), stack);
+    solver.factor(state);
+    std::vector<Vec3> r = child_arm, s = parent_arm;
+    std::vector<Vec6>& u = fused[stack];
+    u.assign(model.count, Vec6::Zero());
+    solver.factor_and_solve(rotation, r, s, f, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
+    rows[stack].assign(model.count, Vec6::Zero());
+    solver.solve(zero, c, rows[stack]);
+  }
+  for (int i = 1; i < model.count; ++i) {
+    EXPECT_EQ(fused[0][i], fused[1][i]) << "body " << i;
+    EXPECT_EQ(rows[0][i], rows[1][i]) << "body " << i;
+  }
+}
+
+TEST(TreeSolver, FoldingOnAStackNeedsDepthFirstOrder) {
+  // parent[i] < i is not enough: here body 3 (a child of 1) comes between body 2 and its child 4, so the
+  // sweep leaves 2's subtree before finishing it.
+  EXPECT_FALSE(TreeSolver::stack_folding_possible({-1, 0, 1, 1, 2}));
+  EXPECT_TRUE(TreeSolver::stack_folding_possible({-1, 0, 1, 2, 1}));    // 1 -> 2 -> 3, 1 -> 4: preorder
+  EXPECT_TRUE(TreeSolver::stack_folding_possible({-1, 0, 0, 2, 2, 0}));  // nails and a fork
+  // A solver for an order that does not allow it keeps the arrays, whatever it is asked.
+  std::srand(11);
+  Model model = test::random_tree(6, 11);
+  model.parent = {-1, 0, 1, 1, 2, 0};
+  test::finish_model(model);
+  TreeSolver solver(model);
+  solver.set_stack_folding(true);
+  EXPECT_FALSE(solver.stack_folding());
 }
 
 // F1^T H^-1 F2 by full solves: the velocity response u = H^-1 [F2; 0] read against F1's wrenches.
