@@ -86,29 +86,35 @@ TreeSolver::TreeSolver(const Model& model)
 
 // Replays the sweep's stack discipline: going tip to base, a body's children must all have been folded
 // into the stack's top entry when the sweep reaches it, and a body's parent is either the top entry or
-// not on the stack at all.
-bool TreeSolver::stack_folding_possible(const std::vector<int>& parent) {
+// not on the stack at all. Returns the deepest the stack gets, or -1 if the order does not allow it.
+int TreeSolver::folding_stack_depth(const std::vector<int>& parent) {
   const int n = static_cast<int>(parent.size());
   std::vector<int> stack;
   std::vector<char> on_stack(n, 0);
+  int deepest = 0;
   for (int i = n - 1; i >= 1; --i) {
     if (on_stack[i]) {
-      if (stack.back() != i) return false;
+      if (stack.back() != i) return -1;
       stack.pop_back();
       on_stack[i] = 0;
     }
     const int p = parent[i];
     if (p == 0 || (!stack.empty() && stack.back() == p)) continue;
-    if (on_stack[p]) return false;
+    if (on_stack[p]) return -1;
     stack.push_back(p);
     on_stack[p] = 1;
+    deepest = std::max(deepest, static_cast<int>(stack.size()));
   }
-  return stack.empty();
+  return stack.empty() ? deepest : -1;
 }
 
+bool TreeSolver::stack_folding_possible(const std::vector<int>& parent) { return folding_stack_depth(parent) >= 0; }
+
 void TreeSolver::set_stack_folding(bool on) {
-  stack_folding_ = on && stack_folding_possible(model_.parent);
-  if (stack_folding_ && folded_.empty()) folded_.resize(n_ + 1);
+  const int depth = on ? folding_stack_depth(model_.parent) : -1;
+  stack_folding_ = depth >= 0;
+  // Entries 1..depth (the sweep's top starts at 0); sized once, never shrunk.
+  if (stack_folding_ && static_cast<int>(folded_.size()) < depth + 1) folded_.resize(depth + 1);
 }
 
 void TreeSolver::factor(const State& state) {

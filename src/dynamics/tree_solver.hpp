@@ -142,6 +142,9 @@ class TreeSolver {
   // The factorization's tip-to-base sweep; with kEliminate also eliminate() for the wrenches *f and c = 0.
   template <bool kEliminate, bool kStack>
   void factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f);
+  // The deepest the folding stack gets for this order of the bodies, or -1 if the order does not allow
+  // it (see stack_folding_possible()).
+  static int folding_stack_depth(const std::vector<int>& parent);
   // Tip to base: y_i = D_i^-1 g_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
   void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
@@ -194,7 +197,7 @@ class TreeSolver {
     Vec6 g;        // as g_ (the fused solve's)
   };
   bool stack_folding_ = false;
-  std::vector<Folded> folded_;      // [1, top] in use during a sweep; sized n_ + 1 once
+  std::vector<Folded> folded_;      // [1, top] in use during a sweep; sized to the deepest it gets
   std::vector<Vec6> g_;             // solve scratch: what the children's joints add to f (zero between solves)
   std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
   std::vector<Vec3> a_;             // solve scratch: joint terms
