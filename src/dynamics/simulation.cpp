@@ -217,7 +217,8 @@ long long Simulation::rejected_substeps() const { return work_->rejected; }
 long long Simulation::joint_iterations() const { return work_->joint_iterations; }
 
 double Simulation::joint_tolerance(double h) const {
-  return fixed_joint_tolerance_ > 0 ? fixed_joint_tolerance_ : std::max(kJointToleranceFloor, kJointToleranceRate * h * h);
+  if (fixed_joint_tolerance_ > 0) return fixed_joint_tolerance_;
+  return std::max(kJointToleranceFloor, kJointToleranceRate * h * h);
 }
 
 void Simulation::set_timestep(double seconds) {

@@ -125,14 +125,8 @@ void TreeSolver::factor(const State& state) {
     child_arm_[i] = rotation_scratch_[i] * model_.joint_in_child[i];
     parent_arm_[i] = rotation_scratch_[parent[i]] * model_.joint_in_parent[i];
   }
-  factor_blocks<false, false>(rotation_scratch_, nullptr);  // arrays: a plain factorization is rare (the first step, a jump)
-}
-
-void TreeSolver::factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
-                        std::vector<Vec3>& parent_arm) {
-  child_arm_.swap(child_arm);
-  parent_arm_.swap(parent_arm);
-  factor_blocks<false, false>(rotation, nullptr);  // arrays: a plain factorization is rare (the first step, a jump)
+  // The arrays: a plain factorization is rare (the first step, a jump; see set_stack_folding()).
+  factor_blocks<false, false>(rotation_scratch_, nullptr);
 }
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in

@@ -62,15 +62,13 @@ class TreeSolver {
 
   // The same at a pose given by every body's world rotation matrix (rotation[i] = R(q_i), body -> world;
   // index 0 unused) and the world lever arms r_k = R_k joint_in_child[k], s_k = R_p joint_in_parent[k],
-  // as the caller already has them (the step computes them for its joint gaps). The arm arrays are taken
-  // over by swapping: the caller gets the previous pose's arrays back, as scratch of the same size.
-  void factor(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm, std::vector<Vec3>& parent_arm);
-
-  // That factorization fused with a solve for the wrenches f and c = 0 (joint velocities held at zero),
-  // handing each body's result to visit(i, u_i, lambda_i) as solve_visiting() does: the solve's
-  // tip-to-base sweep runs inside the factorization's, on the blocks just formed, so the step's velocity
-  // projection costs one pass over the bodies, not two. (With f_i = M_i u_i + impulse, u' is the
-  // velocity that is tangent to the joints at the new pose: what RATTLE's projection needs.)
+  // as the caller already has them (the step computes them for its joint gaps; the arm arrays are taken
+  // over by swapping: the caller gets the previous pose's arrays back, as scratch of the same size),
+  // fused with a solve for the wrenches f and c = 0 (joint velocities held at zero), handing each body's
+  // result to visit(i, u_i, lambda_i) as solve_visiting() does: the solve's tip-to-base sweep runs inside
+  // the factorization's, on the blocks just formed, so the step's velocity projection costs one pass
+  // over the bodies, not two. (With f_i = M_i u_i + impulse, u' is the velocity that is tangent to the
+  // joints at the new pose: what RATTLE's projection needs.)
   template <class Visit>
   void factor_and_solve(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
                         std::vector<Vec3>& parent_arm, const std::vector<Vec6>& f, Visit&& visit) {

@@ -101,8 +101,7 @@ TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
       for (int k = 0; k < 6; ++k) f[i](k) = normal(rng);
 
     TreeSolver apart(model);
-    std::vector<Vec3> r1 = child_arm, s1 = parent_arm;
-    apart.factor(rotation, r1, s1);
+    apart.factor(state);  // the same rotation matrices and arms, from the orientations
     apart.solve(f, c, u, &lambda);
 
     TreeSolver fused(model);
