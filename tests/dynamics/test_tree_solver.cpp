@@ -77,6 +77,23 @@ TEST(TreeSolver, ChainIsLinearTreeToo) {
   }
 }
 
+// A pose as factor_and_solve() takes it: every body's rotation matrix and the world lever arms.
+struct PoseArrays {
+  std::vector<Mat3> rotation;
+  std::vector<Vec3> child_arm, parent_arm;
+};
+
+PoseArrays pose_arrays(const Model& model, const State& state) {
+  PoseArrays out{std::vector<Mat3>(model.count), std::vector<Vec3>(model.count, Vec3::Zero()),
+                 std::vector<Vec3>(model.count, Vec3::Zero())};
+  for (int i = 0; i < model.count; ++i) out.rotation[i] = state.orientation[i].toRotationMatrix();
+  for (int i = 1; i < model.count; ++i) {
+    out.child_arm[i] = out.rotation[i] * model.joint_in_child[i];
+    out.parent_arm[i] = out.rotation[model.parent[i]] * model.joint_in_parent[i];
+  }
+  return out;
+}
+
 TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
   // The step's fused factorization and solve (c = 0) against the two done apart, on random trees at a
   // random pose (rotation matrices and arms handed in, as the step does). 1e-12 relative: the same
@@ -86,13 +103,7 @@ TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
     const Model model = test::random_tree(count, count);
     State state = rest_state(model);
     for (int i = 1; i < count; ++i) state.orientation[i] = Quat::UnitRandom();
-    std::vector<Mat3> rotation(count);
-    std::vector<Vec3> child_arm(count, Vec3::Zero()), parent_arm(count, Vec3::Zero());
-    for (int i = 0; i < count; ++i) rotation[i] = state.orientation[i].toRotationMatrix();
-    for (int i = 1; i < count; ++i) {
-      child_arm[i] = rotation[i] * model.joint_in_child[i];
-      parent_arm[i] = rotation[model.parent[i]] * model.joint_in_parent[i];
-    }
+    PoseArrays pose = pose_arrays(model, state);
     std::mt19937 rng(count);
     std::normal_distribution<double> normal;
     std::vector<Vec6> f(count, Vec6::Zero()), u(count, Vec6::Zero()), fused_u(count, Vec6::Zero());
@@ -106,11 +117,11 @@ TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
 
     TreeSolver fused(model);
     fused.factor(state);  // a first factorization, as the step has one from the step before
-    std::vector<Vec3> r2 = child_arm, s2 = parent_arm;
-    fused.factor_and_solve(rotation, r2, s2, f, [&](int i, const Vec6& ui, const Vec3& lam) {
-      fused_u[i] = ui;
-      fused_lambda[i] = lam;
-    });
+    fused.factor_and_solve(pose.rotation, pose.child_arm, pose.parent_arm, f,
+                           [&](int i, const Vec6& ui, const Vec3& lam) {
+                             fused_u[i] = ui;
+                             fused_lambda[i] = lam;
+                           });
     double scale_u = 0, scale_l = 0, error_u = 0, error_l = 0;
     for (int i = 1; i < count; ++i) {
       scale_u = std::max(scale_u, u[i].norm());
@@ -146,13 +157,7 @@ TEST(TreeSolver, FoldingOnAStackGivesTheSameBitsAsTheArrays) {
   std::srand(5);
   State state = rest_state(model);
   for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
-  std::vector<Mat3> rotation(model.count);
-  for (int i = 0; i < model.count; ++i) rotation[i] = state.orientation[i].toRotationMatrix();
-  std::vector<Vec3> child_arm(model.count, Vec3::Zero()), parent_arm(model.count, Vec3::Zero());
-  for (int i = 1; i < model.count; ++i) {
-    child_arm[i] = rotation[i] * model.joint_in_child[i];
-    parent_arm[i] = rotation[model.parent[i]] * model.joint_in_parent[i];
-  }
+  const PoseArrays pose = pose_arrays(model, state);
   std::mt19937 rng(9);
   std::normal_distribution<double> normal;
   std::vector<Vec6> f(model.count, Vec6::Zero()), zero(model.count, Vec6::Zero());
@@ -167,10 +172,11 @@ TEST(TreeSolver, FoldingOnAStackGivesTheSameBitsAsTheArrays) {
     solver.set_stack_folding(stack);
     ASSERT_EQ(solver.stack_folding(), stack);
     solver.factor(state);
-    std::vector<Vec3> r = child_arm, s = parent_arm;
+    PoseArrays arms = pose;  // factor_and_solve takes the arm arrays over
     std::vector<Vec6>& u = fused[stack];
     u.assign(model.count, Vec6::Zero());
-    solver.factor_and_solve(rotation, r, s, f, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
+    solver.factor_and_solve(arms.rotation, arms.child_arm, arms.parent_arm, f,
+                            [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
     rows[stack].assign(model.count, Vec6::Zero());
     solver.solve(zero, c, rows[stack]);
   }
