@@ -148,6 +148,18 @@ const Vec3& farthest_along(const std::vector<Vec3>& points, const Vec3& d) {
 
 }  // namespace
 
+Vec3 ConvexPiece::core_support(const Vec3& d) const {
+  switch (kind) {
+    case Kind::Sphere:
+      return a;
+    case Kind::Cylinder:
+      return d.dot(b - a) >= 0 ? b : a;
+    case Kind::Polytope:
+      return support(d);
+  }
+  return a;
+}
+
 Vec3 ConvexPiece::support(const Vec3& d) const {
   switch (kind) {
     case Kind::Sphere: {

@@ -47,6 +47,11 @@ struct ConvexPiece {
 
   // The point of the piece farthest along `direction` (body frame; direction need not be unit).
   Vec3 support(const Vec3& direction) const;
+  // The same for the piece's core: a sphere's centre, a cylinder's axis (the segment a-b), a polytope
+  // itself. A round piece is its core grown by `radius` (a sphere exactly; a cylinder lies inside that
+  // capsule), and the core's support is a point or a segment end, so GJK on cores ends in finitely many
+  // steps where on a round support it only converges.
+  Vec3 core_support(const Vec3& direction) const;
   // Largest distance (m) from `point` (body frame) to any point of the piece. Exact.
   double farthest_distance(const Vec3& point) const;
 };

@@ -48,6 +48,17 @@ double gap_along(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   return (on_a - on_b).dot(n);
 }
 
+// Whether the unit world direction n is across piece's axis, when it is a wire: the point of its axis
+// closest to the other piece, moved out by the radius against n, is then on the wire (its side, or the
+// rim of an end), so the cores' distance minus the radii is the pieces' own. Tolerance: with n tilted
+// by c = 1e-6 from square, that point is off the wire by r c (0.5 nm for a 0.5 mm thread), and the
+// reported gap (the capsules') stays a lower bound of the true one.
+bool across_axis(const ConvexPiece& piece, const Pose& pose, const Vec3& n) {
+  if (piece.kind != ConvexPiece::Kind::Cylinder) return true;
+  const Vec3 axis = pose.rotation * (piece.b - piece.a);
+  return std::abs(n.dot(axis)) <= 1e-6 * axis.norm();
+}
+
 ccd_t make_ccd() {
   ccd_t ccd;
   CCD_INIT(&ccd);
@@ -68,31 +79,43 @@ ccd_t make_ccd() {
 
 bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
                  double margin, PieceContact& out) {
-  // Apart: GJK distance gives the closest points themselves. A sphere enters as its centre (its core)
-  // and its radius is taken off afterwards: GJK on a point and a polytope ends in finitely many steps,
-  // on a round support it only converges. (Only spheres are copied: they own no vertex arrays.)
-  ConvexPiece centre_a, centre_b;
-  const ConvexPiece& core_a = a.kind == ConvexPiece::Kind::Sphere ? (centre_a = a, centre_a.radius = 0, centre_a) : a;
-  const ConvexPiece& core_b = b.kind == ConvexPiece::Kind::Sphere ? (centre_b = b, centre_b.radius = 0, centre_b) : b;
-  const double ra = a.kind == ConvexPiece::Kind::Sphere ? a.radius : 0.0;
-  const double rb = b.kind == ConvexPiece::Kind::Sphere ? b.radius : 0.0;
+  using Kind = ConvexPiece::Kind;
+  // Apart: GJK distance gives the closest points themselves, first of the pieces' cores (a sphere's
+  // centre, a wire's axis; ConvexPiece::core_support), the radii taken off afterwards. GJK on cores ends
+  // in finitely many steps; on a round support it only converges: 27 iterations per call on average for
+  // a wire against a plate or a wire's end, against 10-15 for two plates (generated-127 and 1023 after
+  // the breeze). A sphere is its centre grown by its radius, so the cores give its distance exactly. A
+  // wire lies inside the capsule of its axis and radius, so the cores' distance minus the radii is at
+  // most the pieces' distance: enough to rule the pair out beyond the margin, and equal to it when the
+  // direction between the closest points is across the wire's axis (the point moved out by the radius
+  // is then on its side or the rim of an end). Otherwise an end face of the wire is nearest, and GJK
+  // measures the wire whole.
   // The gap is taken from GJK's certified lower bound, never from its estimate, which is above the true
   // distance where GJK stops at its iteration limit (by up to millimetres on wires lying along plates):
   // taken as the gap, that hid contacts (estimate beyond the margin, truth within) and, remembered by the
   // detector's coherence cache as a lower bound, let it skip pairs that had come into contact. A wire of
   // the shaken Steel Fish went 7 mm into a 1.5 mm plate that way (narrow_phase.hpp; test
   // Detector.RememberedDistancesGiveTheContactsOfAFreshDetector).
-  const GjkResult g = gjk_distance(core_a, pose_a, core_b, pose_b);
-  if (!g.overlap && g.distance > ra + rb) {
+  const bool round_a = a.kind != Kind::Polytope, round_b = b.kind != Kind::Polytope;
+  const auto apart = [&](const GjkResult& g, double ra, double rb) {  // g apart by more than ra + rb
     const double gap = std::max(g.lower - ra - rb, 0.0);  // at most the true gap, or 0 (touching) if unsure
-    if (!(gap < margin)) {
-      out.distance = gap;  // a bound for the detector's coherence (narrow_phase.hpp)
-      return false;
-    }
     out.normal = (g.on_a - g.on_b) / g.distance;
-    out.distance = gap;
+    out.distance = gap;  // beyond the margin: a bound for the detector's coherence (narrow_phase.hpp)
     out.point = 0.5 * ((g.on_a - ra * out.normal) + (g.on_b + rb * out.normal));
-    return true;
+    return gap < margin;
+  };
+  const double ra = round_a ? a.radius : 0.0, rb = round_b ? b.radius : 0.0;
+  const GjkResult cores = gjk_distance(a, pose_a, b, pose_b, round_a, round_b);
+  if (!cores.overlap && cores.distance > ra + rb) {
+    const bool in_contact = apart(cores, ra, rb);
+    if (!in_contact || (across_axis(a, pose_a, out.normal) && across_axis(b, pose_b, out.normal))) return in_contact;
+  }
+  if (a.kind == Kind::Cylinder || b.kind == Kind::Cylinder) {
+    // A wire's end is nearest, or the capsules touch: the wires whole (spheres still as centres).
+    const bool sphere_a = a.kind == Kind::Sphere, sphere_b = b.kind == Kind::Sphere;
+    const double sa = sphere_a ? a.radius : 0.0, sb = sphere_b ? b.radius : 0.0;
+    const GjkResult g = gjk_distance(a, pose_a, b, pose_b, sphere_a, sphere_b);
+    if (!g.overlap && g.distance > sa + sb) return apart(g, sa, sb);
   }
   // Overlapping: libccd's EPA on the pieces inflated by margin / 2 each (see the top of this file).
   out.distance = 0;  // nothing known, should this end without a contact
@@ -158,15 +181,8 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   // overlap the other way, and the overlap correction then pushed one wire through the other). While a
   // wire's axis (a segment) or a sphere's centre is still outside the other piece, the direction between
   // the closest points of those cores is the separating one: try it too.
-  if (a.kind != ConvexPiece::Kind::Polytope || b.kind != ConvexPiece::Kind::Polytope) {
-    // Copies only of the round pieces (no vertex arrays): their radius set to zero.
-    ConvexPiece round_a, round_b;
-    const bool polytope_a = a.kind == ConvexPiece::Kind::Polytope, polytope_b = b.kind == ConvexPiece::Kind::Polytope;
-    const ConvexPiece& axis_a = polytope_a ? a : (round_a = a, round_a.radius = 0, round_a);
-    const ConvexPiece& axis_b = polytope_b ? b : (round_b = b, round_b.radius = 0, round_b);
-    const GjkResult cores = gjk_distance(axis_a, pose_a, axis_b, pose_b);
-    if (!cores.overlap && cores.distance > 0) consider((cores.on_a - cores.on_b) / cores.distance);
-  }
+  if ((round_a || round_b) && !cores.overlap && cores.distance > 0)
+    consider((cores.on_a - cores.on_b) / cores.distance);
   out.point = Vec3(pos.v[0], pos.v[1], pos.v[2]);
   // EPA's point is an average over its last face and can be centimetres off. Pull b back along the
   // normal until the gap along it is 1 um, and take the closest points of that separated pair from GJK

@@ -133,17 +133,20 @@ bool closest_to_origin(Simplex& s, std::array<double, 4>& w, Vec3& closest) {
   return true;
 }
 
-Vertex support(const ConvexPiece& a, const Pose& pa, const ConvexPiece& b, const Pose& pb, const Vec3& v) {
+Vertex support(const ConvexPiece& a, const Pose& pa, const ConvexPiece& b, const Pose& pb, const Vec3& v, bool core_a,
+               bool core_b) {
   Vertex x;
-  x.a = pa.to_world(a.support(pa.rotation.transpose() * -v));
-  x.b = pb.to_world(b.support(pb.rotation.transpose() * v));
+  const Vec3 da = pa.rotation.transpose() * -v, db = pb.rotation.transpose() * v;
+  x.a = pa.to_world(core_a ? a.core_support(da) : a.support(da));
+  x.b = pb.to_world(core_b ? b.core_support(db) : b.support(db));
   x.w = x.a - x.b;
   return x;
 }
 
 }  // namespace
 
-GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& b, const Pose& pb) {
+GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& b, const Pose& pb, bool core_a,
+                       bool core_b) {
   GjkResult r;
   const double size = a.bound_radius + b.bound_radius;
   const double tiny2 = 1e-24 * size * size;  // |v|^2 below this is contact (round-off of the supports)
@@ -151,7 +154,7 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
   if (v.squaredNorm() <= tiny2) v = Vec3::UnitX();
   Simplex s;
   std::array<double, 4> w{};
-  s.v[0] = support(a, pa, b, pb, v);
+  s.v[0] = support(a, pa, b, pb, v, core_a, core_b);
   s.n = 1;
   w[0] = 1;
   v = s.v[0].w;
@@ -162,7 +165,7 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
       r.overlap = true;
       return r;
     }
-    const Vertex x = support(a, pa, b, pb, v);
+    const Vertex x = support(a, pa, b, pb, v, core_a, core_b);
     // Every point p of a - b has p.v >= x.w.v (x.w is the support against v).
     r.lower = std::max(r.lower, v.dot(x.w) / std::sqrt(vv));
     // No progress: v is (to a relative 1e-12 of |v|^2) the closest point of A - B.

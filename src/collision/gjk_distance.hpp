@@ -20,6 +20,9 @@ struct GjkResult {
   double lower = 0;
 };
 
-GjkResult gjk_distance(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b);
+// With core_a (core_b), piece a (b) enters as its core (ConvexPiece::core_support): a sphere's centre, a
+// cylinder's axis; the distance of the pieces themselves is then at least this one minus the radii.
+GjkResult gjk_distance(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b,
+                       bool core_a = false, bool core_b = false);
 
 }  // namespace aloft::internal
