@@ -62,6 +62,13 @@ struct Contact {
   // bounds how far that piece's points travel in a step (|v| + |w| reach); infinite when not known (the
   // component's reach then bounds it).
   double reach_a = INFINITY, reach_b = INFINITY;
+  // A box enclosing the convex pieces of a (b) found within the margin of the other component's (the
+  // pieces reach_a, reach_b are taken over), in a's (b's) body frame (principal axes, origin at the
+  // centre of mass; m): the fastest point of those pieces at velocities v, w is at one of its corners,
+  // |v + w x corner| (Simulation's limit on how far pieces in contact travel). Empty (low > high) when
+  // not known.
+  Vec3 near_low_a = Vec3::Constant(INFINITY), near_high_a = Vec3::Constant(-INFINITY);
+  Vec3 near_low_b = Vec3::Constant(INFINITY), near_high_b = Vec3::Constant(-INFINITY);
 };
 
 class CollisionDetector {

@@ -53,6 +53,8 @@ Bounds set_bounds(ConvexPiece& piece) {
   }
   piece.bound_center = 0.5 * (box.min + box.max);
   piece.bound_radius = piece.farthest_distance(piece.bound_center);
+  piece.box_low = box.min;
+  piece.box_high = box.max;
   piece.reach = piece.farthest_distance(Vec3::Zero());
   return box;
 }

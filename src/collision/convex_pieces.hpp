@@ -43,6 +43,7 @@ struct ConvexPiece {
   Vec3 prism_half = Vec3::Zero();  // half the thickness along the plate's normal, body frame, m
   Vec3 bound_center = Vec3::Zero();  // a sphere enclosing the piece (body frame, m)
   double bound_radius = 0;
+  Vec3 box_low = Vec3::Zero(), box_high = Vec3::Zero();  // a box enclosing it, body axes (body frame, m)
   double reach = 0;                  // m: largest distance from the centre of mass (body origin) to the piece
 
   // The point of the piece farthest along `direction` (body frame; direction need not be unit).

@@ -80,7 +80,7 @@ struct CollisionDetector::Impl {
   std::vector<Vec3> piece_center;  // world centres of a's pieces for the current pair
   struct Found {
     PieceContact contact;
-    double reach_a, reach_b;  // of the two pieces (ConvexPiece::reach)
+    const ConvexPiece *piece_a, *piece_b;
   };
   std::vector<Found> found;
 
@@ -141,24 +141,32 @@ struct CollisionDetector::Impl {
           if (apart - kCoherenceRelativeSlack * bound.distance - kCoherenceSlack > pair_margin) continue;
         }
         if (internal::piece_contact(x, pose[a], y, pose[b], pair_margin, c)) {
-          found.push_back({c, x.reach, y.reach});
+          found.push_back({c, &x, &y});
           bound.key = ~std::uint64_t{0};
         } else {
           bound = {key, c.distance, odometer[a], odometer[b]};
         }
       }
     }
-    // Every contact of the pair carries the largest reach of all the pieces found near each other,
-    // including any the cut below drops (their travel must be bounded too).
+    // Every contact of the pair carries the largest reach, and a box around, all the pieces found near
+    // each other, including any the cut below drops (their travel must be bounded too).
     double reach_a = 0, reach_b = 0;
-    for (const Found& f : found) reach_a = std::max(reach_a, f.reach_a), reach_b = std::max(reach_b, f.reach_b);
+    Vec3 low_a = Vec3::Constant(INFINITY), high_a = Vec3::Constant(-INFINITY);
+    Vec3 low_b = low_a, high_b = high_a;
+    for (const Found& f : found) {
+      reach_a = std::max(reach_a, f.piece_a->reach);
+      reach_b = std::max(reach_b, f.piece_b->reach);
+      low_a = low_a.cwiseMin(f.piece_a->box_low), high_a = high_a.cwiseMax(f.piece_a->box_high);
+      low_b = low_b.cwiseMin(f.piece_b->box_low), high_b = high_b.cwiseMax(f.piece_b->box_high);
+    }
     if (found.size() > kMaxContactsPerPair) {
       std::stable_sort(found.begin(), found.end(),
                        [](const Found& p, const Found& q) { return p.contact.distance < q.contact.distance; });
       found.resize(kMaxContactsPerPair);
     }
     for (const Found& f : found)
-      contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b});
+      contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b, low_a,
+                          high_a, low_b, high_b});
   }
 };
 

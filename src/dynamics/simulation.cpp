@@ -263,6 +263,28 @@ bool Simulation::reject_spin(double h) {
   return false;
 }
 
+namespace {
+
+// The largest speed (m/s) of a corner of the box [low, high] (body frame of a body at `orientation`,
+// origin at its centre of mass) when the body moves at v and turns at w (world): max |v + w x r| over
+// the 8 corners r. |v + w x r| is convex in r, so this bounds the speed of every point of the box.
+double fastest_corner_speed(const Quat& orientation, const Vec3& v, const Vec3& w, const Vec3& low, const Vec3& high) {
+  const Mat3 turn = orientation.toRotationMatrix();
+  const Vec3 w_body = turn.transpose() * w;
+  const Vec3 middle = turn.transpose() * v + w_body.cross(0.5 * (low + high));  // the box centre's velocity
+  const Vec3 half = 0.5 * (high - low);
+  const Vec3 e0 = w_body.cross(Vec3(half.x(), 0, 0)), e1 = w_body.cross(Vec3(0, half.y(), 0)),
+             e2 = w_body.cross(Vec3(0, 0, half.z()));
+  double fastest = 0;
+  for (const double s0 : {-1.0, 1.0})
+    for (const double s1 : {-1.0, 1.0})
+      for (const double s2 : {-1.0, 1.0})
+        fastest = std::max(fastest, (middle + s0 * e0 + s1 * e1 + s2 * e2).squaredNorm());
+  return std::sqrt(fastest);
+}
+
+}  // namespace
+
 // With collisions on: whether no component turns more than kOldTurnLimit in a step of h, and every
 // component in a contact found for this step moves (any point of it, at the given velocities) at most
 // kMaxContactTravel. A contact is a constraint at one point with one normal, from the closest features
@@ -280,16 +302,24 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   // limit too.
   for (std::size_t i = 1; i < angular.size(); ++i)
     if (h * angular[i].norm() > kOldTurnLimit) return false;
-  // The travel of the pieces in contact: |v| + |w| times the piece's reach from the centre of mass (a
-  // plate's, not its thread's up to the joint). Any other piece of the pair that could come near within
-  // the step is within the detection margin, which the component's whole reach sets, so it is a contact
-  // of its own, checked here too.
+  // The travel of the pieces in contact, from the speed of their fastest point: at most |v| + |w| times
+  // the pieces' reach from the centre of mass (a plate's, not its thread's up to the joint), and at most
+  // the fastest corner of the box around them, |v + w x corner| (sharper for a piece turning about an
+  // axis through or near it, as a plate spinning on its thread). Any other piece of the pair that could
+  // come near within the step is within the detection margin, which the component's whole reach sets,
+  // so it is a contact of its own, checked here too.
   for (const Contact& c : work.contacts) {
-    for (const auto& [i, piece_reach] : {std::pair{c.a, c.reach_a}, std::pair{c.b, c.reach_b}}) {
+    for (int side = 0; side < 2; ++side) {
+      const int i = side == 0 ? c.a : c.b;
       if (i == 0) continue;
-      const double reach = std::min(work.detector->reach(i), piece_reach);
+      const double reach = std::min(work.detector->reach(i), side == 0 ? c.reach_a : c.reach_b);
       const double speed = velocity[i].norm() + angular[i].norm() * reach;
-      if (h * speed > kMaxContactTravel) return false;
+      if (h * speed <= kMaxContactTravel) continue;
+      const Vec3& low = side == 0 ? c.near_low_a : c.near_low_b;
+      const Vec3& high = side == 0 ? c.near_high_a : c.near_high_b;
+      if (!(low.x() <= high.x()) ||
+          h * fastest_corner_speed(state_.orientation[i], velocity[i], angular[i], low, high) > kMaxContactTravel)
+        return false;
     }
   }
   return true;
