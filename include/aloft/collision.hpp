@@ -94,6 +94,13 @@ class CollisionDetector {
   // gives the same contacts in the same order, whatever states the detector saw before (it remembers
   // distances between calls only to skip pairs that cannot touch). Does not allocate once warmed up.
   void find_contacts(const State& state, double step, double base_margin, std::vector<Contact>& contacts);
+  // Of `found`, what find_contacts(state, step, base_margin) would give, when `found` came from a call
+  // at the same pose whose margins were all at least as wide: the contacts below this margin, in the
+  // same order (a pair's deepest are the same whatever the margin). Their reach and near boxes stay
+  // those of the wider call (at least as large). Lets a caller whose velocities changed after a wider
+  // look skip looking again.
+  void keep_within_margin(const std::vector<Contact>& found, const State& state, double step, double base_margin,
+                          std::vector<Contact>& kept) const;
 
  private:
   struct Impl;

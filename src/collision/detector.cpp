@@ -57,6 +57,14 @@ using internal::ConvexPiece;
 using internal::PieceContact;
 using internal::Pose;
 
+namespace {
+// A component's share of a pair's margin (m; see the contract of find_contacts).
+double component_margin(const ComponentGeometry& g, const Vec3& velocity, const Vec3& angular, double step,
+                        double base_margin) {
+  return 0.5 * base_margin + step * (velocity.norm() + angular.norm() * g.reach);
+}
+}  // namespace
+
 struct CollisionDetector::Impl {
   std::vector<ComponentGeometry> geometry;
   internal::PairFilter filter;
@@ -81,6 +89,7 @@ struct CollisionDetector::Impl {
   struct Found {
     PieceContact contact;
     const ConvexPiece *piece_a, *piece_b;
+    int order;  // the how-manieth of the pair's contacts found (piece order)
   };
   std::vector<Found> found;
 
@@ -104,8 +113,7 @@ struct CollisionDetector::Impl {
       last_orientation[i] = state.orientation[i];
       last_position[i] = state.position[i];
       pose[i] = {state.orientation[i].toRotationMatrix(), state.position[i]};
-      const double speed = state.velocity[i].norm() + state.angular[i].norm() * g.reach;
-      margin[i] = 0.5 * base_margin + step * speed;
+      margin[i] = component_margin(g, state.velocity[i], state.angular[i], step, base_margin);
       broad.box(i) = internal::box_of(pose[i], g.box_center, g.box_half, margin[i]);
     }
     placed_before = true;
@@ -141,7 +149,7 @@ struct CollisionDetector::Impl {
           if (apart - kCoherenceRelativeSlack * bound.distance - kCoherenceSlack > pair_margin) continue;
         }
         if (internal::piece_contact(x, pose[a], y, pose[b], pair_margin, c)) {
-          found.push_back({c, &x, &y});
+          found.push_back({c, &x, &y, static_cast<int>(found.size())});
           bound.key = ~std::uint64_t{0};
         } else {
           bound = {key, c.distance, odometer[a], odometer[b]};
@@ -160,9 +168,12 @@ struct CollisionDetector::Impl {
       low_b = low_b.cwiseMin(f.piece_b->box_low), high_b = high_b.cwiseMax(f.piece_b->box_high);
     }
     if (found.size() > kMaxContactsPerPair) {
+      // The deepest, kept in piece order: then a look with a wider margin, which finds more shallow
+      // ones, keeps the same contacts in the same order (keep_within_margin).
       std::stable_sort(found.begin(), found.end(),
                        [](const Found& p, const Found& q) { return p.contact.distance < q.contact.distance; });
       found.resize(kMaxContactsPerPair);
+      std::sort(found.begin(), found.end(), [](const Found& p, const Found& q) { return p.order < q.order; });
     }
     for (const Found& f : found)
       contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b, low_a,
@@ -212,6 +223,18 @@ void CollisionDetector::find_contacts(const State& state, double step, double ba
   d.broad.sweep(d.overlaps);
   for (const auto& [a, b] : d.overlaps)
     if (d.is_candidate(a, b)) d.narrow(a, b, contacts);
+}
+
+void CollisionDetector::keep_within_margin(const std::vector<Contact>& found, const State& state, double step,
+                                           double base_margin, std::vector<Contact>& kept) const {
+  const Impl& d = *impl_;
+  kept.clear();
+  for (const Contact& c : found) {
+    const double margin =
+        component_margin(d.geometry[c.a], state.velocity[c.a], state.angular[c.a], step, base_margin) +
+        component_margin(d.geometry[c.b], state.velocity[c.b], state.angular[c.b], step, base_margin);
+    if (c.distance < margin) kept.push_back(c);
+  }
 }
 
 }  // namespace aloft

@@ -55,6 +55,11 @@ constexpr double kMaxContactTravel = 5e-4;
 // millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
 // list from one step to the next without testing pieces that are far apart.
 constexpr double kContactMargin = 5e-4;
+// The detection at the start of a step looks this much (m) further from each component than its margin,
+// so that when the impulses change the velocities, the contacts within the new margins can be picked
+// from what it found instead of detecting again, as long as no component's margin grew by more (see
+// kick_and_collide).
+constexpr double kRecheckSlack = 1e-4;
 // Contacts re-checked after the joints' impulses: at most this many corrections per step, each when a
 // contact approaches faster than this (m/s; 1e-6 m/s closes 1 nm per step).
 constexpr int kMaxContactPasses = 2;
@@ -88,6 +93,7 @@ struct StepWorkspace {
         response(model),
         pseudo(model.count, Vec6::Zero()),
         probe(rest_state(model)),
+        detected_travel(model.count, 0.0),
         step_rule(model) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
     for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
@@ -125,6 +131,8 @@ struct StepWorkspace {
   ContactResponse response;
   std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
   State probe;                    // the current pose with the half-step velocities, for detection
+  std::vector<Contact> nearby;    // found within the margins plus kRecheckSlack (see kick_and_collide)
+  std::vector<double> detected_travel;  // per component: h times its speed bound at detection (m)
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
   // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
@@ -264,6 +272,11 @@ bool Simulation::reject_spin(double h) {
 }
 
 namespace {
+
+// A component's speed bound (m/s) as the detector takes it for its margin: |v| + |w| times its reach.
+double detection_speed(const CollisionDetector& detector, int i, const Vec3& v, const Vec3& w) {
+  return v.norm() + w.norm() * detector.reach(i);
+}
 
 // The largest speed (m/s) of a corner of the box [low, high] (body frame of a body at `orientation`,
 // origin at its centre of mass) when the body moves at v and turns at w (world): max |v + w x r| over
@@ -482,19 +495,34 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
       probe.velocity[i] = next.velocity[i];
       probe.angular[i] = next.angular[i];
     }
-    work.detector->find_contacts(probe, h, kContactMargin, work.contacts);
+    // Looking kRecheckSlack further from every component than its margin: `nearby`; the contacts
+    // within the margins themselves are picked from it.
+    work.detector->find_contacts(probe, h, kContactMargin + 2 * kRecheckSlack, work.nearby);
+    for (int i = 0; i < n; ++i)
+      work.detected_travel[i] = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
+    work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
     if (!contacts_move_slowly_enough(h, probe.velocity, probe.angular)) return false;
     if (!work.contacts.empty())
       contact_report =
           work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
     // A knock can send a component off faster than its margin assumed: look again with the new
     // velocities, and if that finds other contacts, solve them all (what was solved needs nothing more).
+    // When no component's margin grew by more than kRecheckSlack, every contact within the new margins
+    // is in `nearby`: `aloft_step_profile` after the breeze, collisions on, needed the detector again
+    // for 38 of 979 looks on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps);
+    // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more).
     if (contact_report.active > 0) {
+      bool covered = true;
       for (int i = 1; i < n; ++i) {
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
+        const double travel = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
+        covered = covered && travel <= work.detected_travel[i] + kRecheckSlack;
       }
-      work.detector->find_contacts(probe, h, kContactMargin, work.recheck);
+      if (covered)
+        work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
+      else
+        work.detector->find_contacts(probe, h, kContactMargin, work.recheck);
       const auto same_pair = [](const Contact& x, const Contact& y) { return x.a == y.a && x.b == y.b; };
       const bool other = work.recheck.size() != work.contacts.size() ||
                          !std::equal(work.recheck.begin(), work.recheck.end(), work.contacts.begin(), same_pair);

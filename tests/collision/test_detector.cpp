@@ -136,5 +136,60 @@ TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
   EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
 }
 
+TEST(Detector, KeepingWithinANarrowerMarginGivesWhatALookWithItFinds) {
+  // Along the shaken Steel Fish: contacts found within a wider margin (0.2 mm more, as Simulation's
+  // first look of a step) at the state's velocities, then narrowed to the base margin at velocities
+  // 10% slower (the margins all shrink, as when a knock has changed the velocities), against a look
+  // with that margin and those velocities.
+  const Model m = load_mobile(std::string(ALOFT_SOURCE_DIR) + "/mobiles/steel-fish.json");
+  Simulation sim(m);
+  CollisionDetector wide_look(m), fresh_look(m);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  std::vector<Contact> wide, kept, fresh;
+#ifdef ALOFT_SANITIZED
+  const int steps = 5000;  // the sanitizers are ten times slower
+#else
+  const int steps = 30000;
+#endif
+  int with_contacts = 0, dropped = 0;
+  for (int step = 0; step < steps; ++step) {
+    if (step % 50 == 0) {
+      const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));  // as in the shaken Steel Fish test
+      for (int i = 1; i < m.count; ++i) sim.loads().force[i] = m.mass[i] * jerk;
+    }
+    ASSERT_TRUE(sim.step()) << sim.failure()->message;
+    State slower = sim.state();
+    for (int i = 0; i < m.count; ++i) slower.velocity[i] *= 0.9, slower.angular[i] *= 0.9;
+    wide_look.find_contacts(sim.state(), 0.001, 7e-4, wide);
+    wide_look.keep_within_margin(wide, slower, 0.001, 5e-4, kept);
+    fresh_look.find_contacts(slower, 0.001, 5e-4, fresh);
+    with_contacts += !fresh.empty();
+    dropped += static_cast<int>(wide.size() - kept.size());
+    ASSERT_EQ(kept.size(), fresh.size()) << "step " << step;
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+      ASSERT_EQ(kept[k].a, fresh[k].a) << "step " << step;
+      ASSERT_EQ(kept[k].b, fresh[k].b) << "step " << step;
+      // Apart, the distance and closest points do not depend on the margin; an overlap's do, a little
+      // (EPA works on the pieces grown by half the margin each), and is an overlap in both.
+      if (fresh[k].distance >= 0) {
+        ASSERT_EQ(kept[k].distance, fresh[k].distance) << "step " << step;
+        ASSERT_EQ(kept[k].normal, fresh[k].normal) << "step " << step;
+      } else {
+        ASSERT_LT(kept[k].distance, 0) << "step " << step;
+      }
+      // What bounds the travel is at least what the narrower look gives.
+      ASSERT_GE(kept[k].reach_a, fresh[k].reach_a) << "step " << step;
+      ASSERT_GE(kept[k].reach_b, fresh[k].reach_b) << "step " << step;
+      ASSERT_TRUE((kept[k].near_low_a.array() <= fresh[k].near_low_a.array()).all()) << "step " << step;
+      ASSERT_TRUE((kept[k].near_high_b.array() >= fresh[k].near_high_b.array()).all()) << "step " << step;
+    }
+  }
+  std::printf("%d steps compared, %d with contacts, %d contacts of the wider look dropped\n", steps, with_contacts,
+              dropped);
+  EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
+  EXPECT_GT(dropped, 0) << "the wider look should find contacts the narrower one does not";
+}
+
 }  // namespace
 }  // namespace aloft
