@@ -133,6 +133,7 @@ struct StepWorkspace {
   State probe;                    // the current pose with the half-step velocities, for detection
   std::vector<Contact> nearby;    // found within the margins plus kRecheckSlack (see kick_and_collide)
   std::vector<double> detected_travel;  // per component: h times its speed bound at detection (m)
+  bool last_look_active = false;  // the last detection's contacts had impulses
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
   // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
@@ -495,9 +496,11 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
       probe.velocity[i] = next.velocity[i];
       probe.angular[i] = next.angular[i];
     }
-    // Looking kRecheckSlack further from every component than its margin: `nearby`; the contacts
-    // within the margins themselves are picked from it.
-    work.detector->find_contacts(probe, h, kContactMargin + 2 * kRecheckSlack, work.nearby);
+    // Looking kRecheckSlack further from every component than its margin (when the last look's contacts
+    // had impulses, so that this one's will likely need looking again): `nearby`; the contacts within the
+    // margins themselves are picked from it.
+    const double slack = work.last_look_active ? kRecheckSlack : 0.0;
+    work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
     for (int i = 0; i < n; ++i)
       work.detected_travel[i] = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
@@ -511,13 +514,14 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     // is in `nearby`: `aloft_step_profile` after the breeze, collisions on, needed the detector again
     // for 38 of 979 looks on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps);
     // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more).
+    work.last_look_active = contact_report.active > 0;
     if (contact_report.active > 0) {
       bool covered = true;
       for (int i = 1; i < n; ++i) {
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
         const double travel = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
-        covered = covered && travel <= work.detected_travel[i] + kRecheckSlack;
+        covered = covered && travel <= work.detected_travel[i] + slack;
       }
       if (covered)
         work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
