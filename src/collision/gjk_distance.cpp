@@ -166,6 +166,7 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
       return r;
     }
     const Vertex x = support(a, pa, b, pb, v, core_a, core_b);
+    ++r.iterations;
     // Every point p of a - b has p.v >= x.w.v (x.w is the support against v).
     r.lower = std::max(r.lower, v.dot(x.w) / std::sqrt(vv));
     // No progress: v is (to a relative 1e-12 of |v|^2) the closest point of A - B.
@@ -178,6 +179,12 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
       r.overlap = true;
       return r;
     }
+    // No progress: |v| falls at every step of exact arithmetic, so if it did not, the closest point of
+    // the simplex is as close as rounding lets it be told (the new support only went round the closest
+    // face). Pieces a few tenths of a millimetre apart two metres from the origin (a generated mobile's
+    // plates) never met the relative test above: GJK went round to its 64-iteration limit in 11 % of the
+    // calls for two plates on generated-127, with v unchanged and the certified bound within 1e-13 m.
+    if (!(v.squaredNorm() < vv)) break;
   }
   if (v.squaredNorm() <= tiny2) {
     r.overlap = true;

@@ -18,6 +18,7 @@ struct GjkResult {
   // converged; below it when GJK stopped at its iteration limit, as it can on a wire's round side lying
   // along a plate or another wire (seen: 2.01 mm estimated, 1.57 mm certain, after 64 iterations).
   double lower = 0;
+  int iterations = 0;  // support points taken (at most 64)
 };
 
 // With core_a (core_b), piece a (b) enters as its core (ConvexPiece::core_support): a sphere's centre, a

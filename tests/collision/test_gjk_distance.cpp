@@ -79,5 +79,49 @@ TEST(GjkDistance, ParallelBoxesAndThinPlatesAreNeverCalledOverlappingWhenApart) 
   EXPECT_GT(overlapping, 100);
 }
 
+TEST(GjkDistance, PlatesTwoMetresFromTheOriginEndWellBeforeTheIterationLimit) {
+  // Hexagonal plates 2 mm thick, 0.01-1 mm apart, where a mobile hangs (about 2 m from the origin),
+  // nearly parallel (within 0.05 rad) or at random: rounding in the support points, a few ulps of 2 m,
+  // is then about as large as what the relative stopping test asks of |v|^2. GJK went round the
+  // closest face to its 64-iteration limit in 11 % of the plate pairs of generated-127 until it stopped
+  // on making no progress.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  std::vector<Vec3> hexagon;
+  for (int k = 0; k < 6; ++k) {
+    const Vec3 p(0.03 * std::cos(M_PI / 3 * k), 0.03 * std::sin(M_PI / 3 * k), 0);
+    hexagon.push_back(p + Vec3(0, 0, 0.001));
+    hexagon.push_back(p - Vec3(0, 0, 0.001));
+  }
+  const ConvexPiece a = polytope_of(hexagon), b = polytope_of(hexagon);
+  const Vec3 where(0.3, 1.8, -0.5);
+  int most = 0, measured = 0;
+  double worst_certificate = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Mat3 ra = Eigen::AngleAxisd(M_PI * unit(rng), Vec3(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+    const double tilt = trial % 2 ? 0.05 * unit(rng) : M_PI * unit(rng);
+    const Mat3 rb = ra * Eigen::AngleAxisd(tilt, Vec3(u(rng), u(rng), 0).normalized()).toRotationMatrix();
+    // b beside a's face, or off its edge, then moved along a's normal to leave a gap.
+    const Vec3 along = ra * Vec3(0.05 * u(rng), 0.05 * u(rng), 0);
+    const Pose pa{ra, where}, pb0{rb, where + along};
+    const Vec3 normal = ra.col(2);
+    const double overlap = gap_along(a, pa, b, pb0, -normal);  // b below a: push it down by -overlap
+    const double gap = 1e-5 + 1e-3 * unit(rng);
+    const Pose pb{rb, pb0.position - (gap - overlap) * normal};
+    const GjkResult g = gjk_distance(a, pa, b, pb);
+    if (g.overlap) continue;
+    ++measured;
+    most = std::max(most, g.iterations);
+    // The certificate: the gap along GJK's own direction is at most the distance, |on_a - on_b| at
+    // least it; for two polytopes they meet, up to rounding: the closest point of a nearly flat
+    // simplex with coordinates of 2 m (seen: 6e-13 m).
+    const Vec3 n = (g.on_a - g.on_b) / g.distance;
+    worst_certificate = std::max(worst_certificate, g.distance - gap_along(a, pa, b, pb, n));
+  }
+  EXPECT_GT(measured, 3000);
+  EXPECT_LE(most, 20);  // two plates: 4-7 iterations as a rule, 13 the most seen on generated-127
+  EXPECT_LT(worst_certificate, 2e-12);
+}
+
 }  // namespace
 }  // namespace aloft::internal
