@@ -6,10 +6,11 @@
 
 namespace aloft::internal {
 
-void BroadPhase::reset(std::vector<int> members, int count, int axis) {
+void BroadPhase::reset(std::vector<int> members, int count, int axis, std::vector<int> parent) {
   order_ = std::move(members);
   boxes_.assign(count, WorldBox{});
   axis_ = axis;
+  parent_ = parent.empty() ? std::vector<int>(count, -1) : std::move(parent);
 }
 
 void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
@@ -45,7 +46,9 @@ void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
       const bool apart = (bi.low[1] > bj.high[1]) | (bj.low[1] > bi.high[1]) | (bi.low[2] > bj.high[2]) |
                          (bj.low[2] > bi.high[2]);
       if (apart) continue;
-      overlaps.emplace_back(std::min(bi.component, bj.component), std::max(bi.component, bj.component));
+      const int low = std::min(bi.component, bj.component), high = std::max(bi.component, bj.component);
+      if (parent_[high] == low) continue;  // joined
+      overlaps.emplace_back(low, high);
     }
   }
   std::sort(overlaps.begin(), overlaps.end());

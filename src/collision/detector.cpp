@@ -191,7 +191,7 @@ CollisionDetector::CollisionDetector(const Model& model)
     rest_points.push_back(model.rest_position[i]);
   }
   // Sweep along the world axis the rest pose spreads most along.
-  d.broad.reset(d.members, model.count, internal::widest_axis(rest_points));
+  d.broad.reset(d.members, model.count, internal::widest_axis(rest_points), model.parent);
   d.pose.resize(model.count);
   d.margin.assign(model.count, 0);
   d.last_orientation.assign(model.count, Quat::Identity());

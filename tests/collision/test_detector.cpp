@@ -8,6 +8,7 @@
 #include "aloft/collision.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
+#include "collision/broad_phase.hpp"
 
 namespace aloft {
 namespace {
@@ -189,6 +190,21 @@ TEST(Detector, KeepingWithinANarrowerMarginGivesWhatALookWithItFinds) {
               dropped);
   EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
   EXPECT_GT(dropped, 0) << "the wider look should find contacts the narrower one does not";
+}
+
+TEST(BroadPhase, LeavesOutAParentAndItsChildButNotSiblings) {
+  // Components 1, 2, 3 with overlapping boxes; 2 and 3 hang from 1. Only the siblings' pair is a
+  // candidate; without the parents every overlapping pair is.
+  const auto overlaps_of = [](std::vector<int> parent) {
+    internal::BroadPhase broad;
+    broad.reset({1, 2, 3}, 4, 0, std::move(parent));
+    for (int i = 1; i <= 3; ++i) broad.box(i) = {Vec3(0.1 * i, 0, 0), Vec3(0.1 * i + 0.25, 1, 1)};
+    std::vector<std::pair<int, int>> overlaps;
+    broad.sweep(overlaps);
+    return overlaps;
+  };
+  EXPECT_EQ(overlaps_of({-1, 0, 1, 1}), (std::vector<std::pair<int, int>>{{2, 3}}));
+  EXPECT_EQ(overlaps_of({}), (std::vector<std::pair<int, int>>{{1, 2}, {1, 3}, {2, 3}}));
 }
 
 }  // namespace
