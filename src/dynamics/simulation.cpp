@@ -93,7 +93,6 @@ struct StepWorkspace {
         response(model),
         pseudo(model.count, Vec6::Zero()),
         probe(rest_state(model)),
-        detected_travel(model.count, 0.0),
         step_rule(model) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
     for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
@@ -132,7 +131,6 @@ struct StepWorkspace {
   std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
   State probe;                    // the current pose with the half-step velocities, for detection
   std::vector<Contact> nearby;    // found within the margins plus kRecheckSlack (see kick_and_collide)
-  std::vector<double> detected_travel;  // per component: h times its speed bound at detection (m)
   bool last_look_active = false;  // the last detection's contacts had impulses
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
@@ -501,8 +499,6 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     // margins themselves are picked from it.
     const double slack = work.last_look_active ? kRecheckSlack : 0.0;
     work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
-    for (int i = 0; i < n; ++i)
-      work.detected_travel[i] = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
     if (!contacts_move_slowly_enough(h, probe.velocity, probe.angular)) return false;
     if (!work.contacts.empty())
@@ -518,10 +514,11 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     if (contact_report.active > 0) {
       bool covered = true;
       for (int i = 1; i < n; ++i) {
+        const double looked = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
         const double travel = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
-        covered = covered && travel <= work.detected_travel[i] + slack;
+        covered = covered && travel <= looked + slack;
       }
       if (covered)
         work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
