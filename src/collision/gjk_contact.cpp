@@ -97,8 +97,10 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   // the shaken Steel Fish went 7 mm into a 1.5 mm plate that way (narrow_phase.hpp; test
   // Detector.RememberedDistancesGiveTheContactsOfAFreshDetector).
   const bool round_a = a.kind != Kind::Polytope, round_b = b.kind != Kind::Polytope;
-  const auto apart = [&](const GjkResult& g, double ra, double rb) {  // g apart by more than ra + rb
-    const double gap = std::max(g.lower - ra - rb, 0.0);  // at most the true gap, or 0 (touching) if unsure
+  // g apart by more than ra + rb; known_gap: a lower bound of the gap known already (m)
+  const auto apart = [&](const GjkResult& g, double ra, double rb, double known_gap) {
+    // At most the true gap, or 0 (touching) if unsure.
+    const double gap = std::max({g.lower - ra - rb, known_gap, 0.0});
     out.normal = (g.on_a - g.on_b) / g.distance;
     out.distance = gap;  // beyond the margin: a bound for the detector's coherence (narrow_phase.hpp)
     out.point = 0.5 * ((g.on_a - ra * out.normal) + (g.on_b + rb * out.normal));
@@ -106,16 +108,21 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   };
   const double ra = round_a ? a.radius : 0.0, rb = round_b ? b.radius : 0.0;
   const GjkResult cores = gjk_distance(a, pose_a, b, pose_b, round_a, round_b);
-  if (!cores.overlap && cores.distance > ra + rb) {
-    const bool in_contact = apart(cores, ra, rb);
+  const bool cores_apart = !cores.overlap && cores.distance > ra + rb;
+  if (cores_apart) {
+    const bool in_contact = apart(cores, ra, rb, 0.0);
     if (!in_contact || (across_axis(a, pose_a, out.normal) && across_axis(b, pose_b, out.normal))) return in_contact;
   }
   if (a.kind == Kind::Cylinder || b.kind == Kind::Cylinder) {
-    // A wire's end is nearest, or the capsules touch: the wires whole (spheres still as centres).
+    // A wire's end is nearest, or the capsules touch: the wires whole (spheres still as centres). The
+    // capsules' gap, when they are apart, bounds the gap from below too (GJK on two round supports can
+    // stall with a looser bound).
     const bool sphere_a = a.kind == Kind::Sphere, sphere_b = b.kind == Kind::Sphere;
     const double sa = sphere_a ? a.radius : 0.0, sb = sphere_b ? b.radius : 0.0;
     const GjkResult g = gjk_distance(a, pose_a, b, pose_b, sphere_a, sphere_b);
-    if (!g.overlap && g.distance > sa + sb) return apart(g, sa, sb);
+    if (!g.overlap && g.distance > sa + sb) return apart(g, sa, sb, cores_apart ? cores.lower - ra - rb : 0.0);
+    // Apart capsules hold apart wires: an overlap here is GJK's rounding, so the capsules answer.
+    if (cores_apart) return apart(cores, ra, rb, 0.0);
   }
   // Overlapping: libccd's EPA on the pieces inflated by margin / 2 each (see the top of this file).
   out.distance = 0;  // nothing known, should this end without a contact

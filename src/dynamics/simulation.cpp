@@ -131,7 +131,7 @@ struct StepWorkspace {
   std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
   State probe;                    // the current pose with the half-step velocities, for detection
   std::vector<Contact> nearby;    // found within the margins plus kRecheckSlack (see kick_and_collide)
-  bool last_look_active = false;  // the last detection's contacts had impulses
+  bool last_look_found = false;   // the last detection found contacts
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
   // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
@@ -494,10 +494,10 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
       probe.velocity[i] = next.velocity[i];
       probe.angular[i] = next.angular[i];
     }
-    // Looking kRecheckSlack further from every component than its margin (when the last look's contacts
-    // had impulses, so that this one's will likely need looking again): `nearby`; the contacts within the
-    // margins themselves are picked from it.
-    const double slack = work.last_look_active ? kRecheckSlack : 0.0;
+    // Looking kRecheckSlack further from every component than its margin (when the last look found
+    // contacts, so that this one's impulses will likely call for looking again): `nearby`; the contacts
+    // within the margins themselves are picked from it.
+    const double slack = work.last_look_found ? kRecheckSlack : 0.0;
     work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
     if (!contacts_move_slowly_enough(h, probe.velocity, probe.angular)) return false;
@@ -509,8 +509,9 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     // When no component's margin grew by more than kRecheckSlack, every contact within the new margins
     // is in `nearby`: `aloft_step_profile` after the breeze, collisions on, needed the detector again
     // for 38 of 979 looks on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps);
-    // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more).
-    work.last_look_active = contact_report.active > 0;
+    // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more);
+    // with the slack only after a look whose contacts had impulses, for 405 and 26.
+    work.last_look_found = !work.contacts.empty();
     if (contact_report.active > 0) {
       bool covered = true;
       for (int i = 1; i < n; ++i) {
