@@ -25,23 +25,37 @@ using Mat3d = Eigen::Matrix3d;
 // The impulse that changes the contact velocity by `change` through the (symmetric, positive
 // semi-definite) block K: K^-1 change, or, when K is singular, the least-squares impulse of least norm
 // (K's pseudo-inverse): the part of `change` no impulse can produce is left out instead of being bought
-// with an unbounded impulse.
-Vec3d block_solve(const Mat3d& K, const Vec3d& change) {
-  const Eigen::LDLT<Mat3d> ldlt(K);
-  const Vec3d pivots = ldlt.vectorD().cwiseAbs();
-  if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff())
-    return ldlt.solve(change);
-  Eigen::SelfAdjointEigenSolver<Mat3d> eigen;
-  eigen.computeDirect(K);
-  const Vec3d values = eigen.eigenvalues();
-  const double cutoff = kSingularBlock * values.cwiseAbs().maxCoeff();
-  Vec3d in_eigenbasis = eigen.eigenvectors().transpose() * change;
-  for (int k = 0; k < 3; ++k) in_eigenbasis[k] = values[k] > cutoff ? in_eigenbasis[k] / values[k] : 0.0;
-  return eigen.eigenvectors() * in_eigenbasis;
-}
+// with an unbounded impulse. Factored once per contact and solve (the block does not change between
+// Gauss-Seidel sweeps).
+class BlockSolver {
+ public:
+  explicit BlockSolver(const Mat3d& K) : ldlt_(K) {
+    const Vec3d pivots = ldlt_.vectorD().cwiseAbs();
+    regular_ = ldlt_.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff();
+    if (regular_) return;
+    Eigen::SelfAdjointEigenSolver<Mat3d> eigen;
+    eigen.computeDirect(K);
+    vectors_ = eigen.eigenvectors();
+    values_ = eigen.eigenvalues();
+  }
+  Vec3d solve(const Vec3d& change) const {
+    if (regular_) return ldlt_.solve(change);
+    const double cutoff = kSingularBlock * values_.cwiseAbs().maxCoeff();
+    Vec3d in_eigenbasis = vectors_.transpose() * change;
+    for (int k = 0; k < 3; ++k) in_eigenbasis[k] = values_[k] > cutoff ? in_eigenbasis[k] / values_[k] : 0.0;
+    return vectors_ * in_eigenbasis;
+  }
+
+ private:
+  Eigen::LDLT<Mat3d> ldlt_;
+  bool regular_ = true;
+  Mat3d vectors_ = Mat3d::Identity();
+  Vec3d values_ = Vec3d::Zero();
+};
 
 // The impulse of one contact (in its basis) given the velocity it would have without its own impulse.
-Vec3d contact_impulse(const Mat3d& K, const Vec3d& u_free, const ContactLawRow& row, bool* sliding) {
+Vec3d contact_impulse(const Mat3d& K, const BlockSolver& block, const Vec3d& u_free, const ContactLawRow& row,
+                      bool* sliding) {
   *sliding = false;
   const double knn = K(0, 0);
   if (!(knn > 0)) return Vec3d::Zero();                // nothing can move at this point
@@ -49,7 +63,7 @@ Vec3d contact_impulse(const Mat3d& K, const Vec3d& u_free, const ContactLawRow& 
 
   // Mirtich's prediction: the impulse that makes the contact stick (normal target met, no slip).
   const Vec3d wanted(row.target_normal, 0, 0);
-  const Vec3d stick = block_solve(K, wanted - u_free);
+  const Vec3d stick = block.solve(wanted - u_free);
   const double tangential = stick.tail<2>().norm();
   if (std::isfinite(tangential) && stick.x() > 0 && tangential <= row.friction * stick.x()) return stick;
 
@@ -86,6 +100,9 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   if (m == 0) return result;
   Eigen::VectorXd velocity = u;  // u + K P, kept current
   std::vector<char> sliding(m, 0);
+  std::vector<BlockSolver> blocks;
+  blocks.reserve(m);
+  for (int k = 0; k < m; ++k) blocks.emplace_back(K.block<3, 3>(3 * k, 3 * k));
   for (int sweep = 1; sweep <= kMaxSweeps; ++sweep) {
     result.iterations = sweep;
     double largest_change = 0, largest_impulse = 0;
@@ -94,7 +111,7 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
       const Vec3d old = P.segment<3>(3 * k);
       const Vec3d u_free = velocity.segment<3>(3 * k) - Kkk * old;
       bool slides = false;
-      const Vec3d next = contact_impulse(Kkk, u_free, rows[k], &slides);
+      const Vec3d next = contact_impulse(Kkk, blocks[k], u_free, rows[k], &slides);
       sliding[k] = slides;
       const Vec3d change = next - old;
       if (change.squaredNorm() > 0) {
