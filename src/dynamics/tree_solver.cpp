@@ -57,7 +57,6 @@ TreeSolver::TreeSolver(const Model& model)
     : model_(model),
       n_(model.count),
       leaf_(n_, 1),
-      inverse_mass_(n_, 0.0),
       inverse_moments_(n_, Vec3::Zero()),
       rotation_scratch_(n_, Mat3::Identity()),
       child_arm_(n_, Vec3::Zero()),
@@ -67,10 +66,8 @@ TreeSolver::TreeSolver(const Model& model)
       sum_a_(n_, Mat3::Zero()),
       sum_b_(n_, Mat3::Zero()),
       sum_c_(n_, Mat3::Zero()),
-      a_inv_(n_, Mat3::Zero()),
-      t_(n_, Mat3::Zero()),
-      s_inv_(n_, Mat3::Zero()),
-      w_(n_, Mat63::Zero()),
+      c_inv_(n_, Mat3::Zero()),
+      p_(n_, Mat3::Zero()),
       k_inv_(n_, Mat3::Zero()),
       g_(n_, Vec6::Zero()),
       y_(n_, Vec6::Zero()),
@@ -78,7 +75,6 @@ TreeSolver::TreeSolver(const Model& model)
       u_(n_, Vec6::Zero()) {
   for (int i = 1; i < n_; ++i) {
     if (model.parent[i] > 0) leaf_[model.parent[i]] = 0;
-    inverse_mass_[i] = 1.0 / model.mass[i];
     inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
   }
   set_stack_folding(n_ >= kStackFoldingBodies);
@@ -130,8 +126,9 @@ void TreeSolver::factor(const State& state) {
 }
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
-// (children have larger indices, so they are done), then joint i eliminated into the parent:
-// A^T K_i^-1 A with A = [E, -[s_i]x] is [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
+// (children have larger indices, so they are done), factored at the joint point (see the header), then
+// joint i eliminated into the parent: A^T K_i^-1 A with A = [E, -[s_i]x] is
+// [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
 // With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
 // With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
 template <bool kEliminate, bool kStack>
@@ -141,65 +138,47 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
   for (int i = n_ - 1; i >= 1; --i) {
     // kStack: what i's children folded into it, on top of the stack (an interior body's always is).
     const Folded* mine = kStack && top > 0 && folded_[top].body == i ? &folded_[top] : nullptr;
-    inertia_[i] = rotate_diagonal(rotation[i], model_.principal_moments[i]);
-    const Mat3 inverse_inertia = rotate_diagonal(rotation[i], inverse_moments_[i]);
-    inverse_inertia_[i] = inverse_inertia;
+    const Mat3 inertia = rotate_diagonal(rotation[i], model_.principal_moments[i]);
+    inertia_[i] = inertia;
+    inverse_inertia_[i] = rotate_diagonal(rotation[i], inverse_moments_[i]);
     const Vec3& r = child_arm_[i];
-    Mat3 k;
-    Vec6 y;  // with kEliminate: D_i^-1 g_i
+    const double m = model_.mass[i];
+    Vec6 g;  // with kEliminate: the wrench gathered at body i (its own and its child joints')
     if constexpr (kEliminate) {
       if constexpr (kStack) {
-        y = (*f)[i];
-        if (mine) y += mine->g;
+        g = (*f)[i];
+        if (mine) g += mine->g;
       } else {
-        y = g_[i] + (*f)[i];
+        g = g_[i] + (*f)[i];
         g_[i].setZero();
       }
     }
+    // D' at the joint point: A = m E + A_f, B' = A [r]x + B_f, C' = I + C_f + B_f^T [r]x - [r]x B'.
+    Mat3 c_inv, p, k_inv;
     if (leaf_[i]) {
-      // D_i = M_i = diag(m E, I): W_i = [E/m; I^-1 [r]x] and K_i = E/m - [r]x I^-1 [r]x.
-      if constexpr (kEliminate) {
-        y.head<3>() *= inverse_mass_[i];
-        y.tail<3>() = inverse_inertia * y.tail<3>();
-      }
-      const Mat3 w_bottom = times_skew(inverse_inertia, r);
-      w_[i].topRows<3>() = inverse_mass_[i] * Mat3::Identity();
-      w_[i].bottomRows<3>() = w_bottom;
-      k = -skew_times(r, w_bottom);
-      k.diagonal().array() += inverse_mass_[i];
+      // A = m E, B' = m [r]x, C' = I + m [r]x^T [r]x = I + m (|r|^2 E - r r^T) (the parallel-axis theorem),
+      // P = m [r]x C'^-1, K^-1 = m E - P B'^T = m E + m P [r]x.
+      Mat3 c_joint = inertia;
+      c_joint.noalias() -= m * (r * r.transpose());
+      c_joint.diagonal().array() += m * r.squaredNorm();
+      c_inv = symmetric_inverse(c_joint);
+      p = m * skew_times(r, c_inv);
+      k_inv = m * times_skew(p, r);
+      k_inv.diagonal().array() += m;
     } else {
-      // W_i = D^-1 [E; [r]x]: with Z = [r]x - T^T, W_bottom = S^-1 Z, W_top = A^-1 - T W_bottom, and
-      // K_i = W_top - [r]x W_bottom = A^-1 + Z^T S^-1 Z.
       const Mat3* folded_a = &sum_a_[i];
       const Mat3* folded_b = &sum_b_[i];
       const Mat3* folded_c = &sum_c_[i];
       if constexpr (kStack) folded_a = &mine->a, folded_b = &mine->b, folded_c = &mine->c;
       Mat3 a = *folded_a;
-      a.diagonal().array() += model_.mass[i];
+      a.diagonal().array() += m;
       const Mat3& b = *folded_b;
-      const Mat3 a_inv = symmetric_inverse(a);
-      const Mat3 t = a_inv * b;
-      const Mat3 s_inv = symmetric_inverse(inertia_[i] + *folded_c - b.transpose() * t);
-      Mat3 z = -t.transpose();
-      z(0, 1) -= r.z();
-      z(0, 2) += r.y();
-      z(1, 0) += r.z();
-      z(1, 2) -= r.x();
-      z(2, 0) -= r.y();
-      z(2, 1) += r.x();
-      const Mat3 w_bottom = s_inv * z;
-      w_[i].topRows<3>() = a_inv - t * w_bottom;
-      w_[i].bottomRows<3>() = w_bottom;
-      k = a_inv + z.transpose() * w_bottom;
-      a_inv_[i] = a_inv;
-      t_[i] = t;
-      s_inv_[i] = s_inv;
-      if constexpr (kEliminate) {
-        const Vec3 g1 = y.head<3>();
-        const Vec3 y2 = s_inv * (y.tail<3>() - t.transpose() * g1);
-        y.head<3>() = a_inv * g1 - t * y2;
-        y.tail<3>() = y2;
-      }
+      const Mat3 b_joint = times_skew(a, r) + b;
+      const Mat3 c_joint = (inertia + *folded_c) + times_skew(b.transpose(), r) - skew_times(r, b_joint);
+      c_inv = symmetric_inverse(c_joint);
+      p.noalias() = b_joint * c_inv;
+      k_inv = a;
+      k_inv.noalias() -= p * b_joint.transpose();
       if constexpr (kStack) {
         --top;  // mine is done with (its entry may be reused below)
       } else {
@@ -208,19 +187,23 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
         sum_c_[i].setZero();
       }
     }
-    const Mat3 k_inv = symmetric_inverse(k);
+    c_inv_[i] = c_inv;
+    p_[i] = p;
     k_inv_[i] = k_inv;
-    const int p = parent[i];
+    const int pa = parent[i];
     Vec3 a;
     if constexpr (kEliminate) {
-      y_[i] = y;
-      a = k_inv * -(y.head<3>() + y.tail<3>().cross(r));  // a_i = K_i^-1 (0 - J_ii y_i)
+      // c_i = 0: h = g's torque about the joint point, e = C'^-1 h, a = P h - g's force.
+      const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
+      y_[i].head<3>().setZero();
+      y_[i].tail<3>() = c_inv * h;
+      a = p * h - g.head<3>();
       a_[i] = a;
     }
-    if (p != 0) {
+    if (pa != 0) {
       const Mat3 k_sx = times_skew(k_inv, parent_arm_[i]);
       if constexpr (kStack) {
-        if (top > 0 && folded_[top].body == p) {  // a sibling began p's entry
+        if (top > 0 && folded_[top].body == pa) {  // a sibling began pa's entry
           Folded& into = folded_[top];
           into.a += k_inv;
           into.b -= k_sx;
@@ -229,9 +212,9 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
             into.g.head<3>() -= a;
             into.g.tail<3>() -= parent_arm_[i].cross(a);
           }
-        } else {  // the first of p's children the sweep reaches: 0 - x, as the arrays' sums start at 0
+        } else {  // the first of pa's children the sweep reaches: 0 - x, as the arrays' sums start at 0
           Folded& into = folded_[++top];
-          into.body = p;
+          into.body = pa;
           into.a = k_inv;
           into.b = -k_sx;
           into.c = -skew_times(parent_arm_[i], k_sx);
@@ -243,12 +226,12 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, const std::vec
           }
         }
       } else {
-        sum_a_[p] += k_inv;
-        sum_b_[p] -= k_sx;
-        sum_c_[p] -= skew_times(parent_arm_[i], k_sx);
+        sum_a_[pa] += k_inv;
+        sum_b_[pa] -= k_sx;
+        sum_c_[pa] -= skew_times(parent_arm_[i], k_sx);
         if constexpr (kEliminate) {
-          g_[p].head<3>() -= a;
-          g_[p].tail<3>() -= parent_arm_[i].cross(a);
+          g_[pa].head<3>() -= a;
+          g_[pa].tail<3>() -= parent_arm_[i].cross(a);
         }
       }
     }
@@ -259,36 +242,31 @@ template void TreeSolver::factor_blocks<true, true>(const std::vector<Mat3>&, co
 template void TreeSolver::factor_blocks<true, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 template void TreeSolver::factor_blocks<false, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 
-// Tip to base: g_i = f_i + what the child joints added, y_i = D_i^-1 g_i, a_i = K_i^-1 (c_i - J_ii y_i),
-// and g_p += J_ip^T a_i. (g_ is zero between solves: each entry is reset once read.)
+// Tip to base: g_i = f_i + what the child joints added, h_i = g_i's torque about the joint point,
+// y_i = (c_i, C'^-1 h_i), a_i = K_i^-1 c_i + P_i h_i - g_i's force, and g_p += J_ip^T a_i. (g_ is zero
+// between solves: each entry is reset once read.)
 template <bool kWithForces>
 void TreeSolver::eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c) {
   const std::vector<int>& parent = model_.parent;
   for (int i = n_ - 1; i >= 1; --i) {
     const Vec3& r = child_arm_[i];
-    Vec3 rhs = c[i];
+    y_[i].head<3>() = c[i];
+    Vec3 a = k_inv_[i] * c[i];
     if (leaf_[i] && !kWithForces) {
-      y_[i].setZero();  // a leaf with no applied wrench: g = 0
+      y_[i].tail<3>().setZero();  // a leaf with no applied wrench: g = 0
     } else {
       Vec6 g = g_[i];
       g_[i].setZero();
       if constexpr (kWithForces) g += (*f)[i];
-      const Vec3 g1 = g.head<3>();
-      if (leaf_[i]) {
-        y_[i].head<3>() = inverse_mass_[i] * g1;
-        y_[i].tail<3>() = inverse_inertia_[i] * g.tail<3>();
-      } else {
-        const Vec3 y2 = s_inv_[i] * (g.tail<3>() - t_[i].transpose() * g1);
-        y_[i].head<3>() = a_inv_[i] * g1 - t_[i] * y2;
-        y_[i].tail<3>() = y2;
-      }
-      rhs -= y_[i].head<3>() + y_[i].tail<3>().cross(r);  // c - (v + w x r)
+      const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
+      y_[i].tail<3>() = c_inv_[i] * h;
+      a += p_[i] * h - g.head<3>();
     }
-    a_[i] = k_inv_[i] * rhs;
+    a_[i] = a;
     const int p = parent[i];
     if (p != 0) {
-      g_[p].head<3>() -= a_[i];
-      g_[p].tail<3>() -= parent_arm_[i].cross(a_[i]);
+      g_[p].head<3>() -= a;
+      g_[p].tail<3>() -= parent_arm_[i].cross(a);
     }
   }
 }
@@ -320,24 +298,13 @@ void TreeSolver::eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_
     Mat63 g = Mat63::Zero();
     if (x == i) g += pending_x;
     if (z == i) g += pending_z;
-    // y = D_i^-1 g (see the factored form in the header).
-    Mat63 y;
-    if (leaf_[i]) {
-      y.topRows<3>() = inverse_mass_[i] * g.topRows<3>();
-      y.bottomRows<3>() = inverse_inertia_[i] * g.bottomRows<3>();
-    } else {
-      const Mat3 y2 = s_inv_[i] * (g.bottomRows<3>() - t_[i].transpose() * g.topRows<3>());
-      y.topRows<3>() = a_inv_[i] * g.topRows<3>() - t_[i] * y2;
-      y.bottomRows<3>() = y2;
-    }
-    // Joint node: j = c - J_ii y with c = 0, i.e. minus the joint point's velocity v + w x r.
-    const Mat3 j = skew_times(child_arm_[i], y.bottomRows<3>()) - y.topRows<3>();
-    const Mat3 a = k_inv_[i] * j;
+    // The torque about the joint point, h = g_torque - [r]x g_force, its turn e = C'^-1 h, and the joint
+    // node's entry a = P h - g_force (c = 0), as in eliminate().
+    const Mat3 h = g.bottomRows<3>() - skew_times(child_arm_[i], g.topRows<3>());
+    const Mat3 a = p_[i] * h - g.topRows<3>();
     out.node.push_back(i);
-    out.g.push_back(g);
-    out.y.push_back(y);
-    out.j.push_back(j);
-    out.a.push_back(a);
+    out.h.push_back(h);
+    out.e.push_back(c_inv_[i] * h);
     // Eliminating joint i adds J_ip^T a = [-a; -[s_i]x a] to the parent's entry.
     const int p = parent[i];
     Mat63 carried;
@@ -364,8 +331,7 @@ Mat3 TreeSolver::coupling(const PathColumns& x, const PathColumns& y) {
     } else if (x.node[p] < y.node[q]) {
       ++q;
     } else {
-      out.noalias() += x.g[p].transpose() * y.y[q];
-      out.noalias() -= x.j[p].transpose() * y.a[q];
+      out.noalias() += x.h[p].transpose() * y.e[q];
       ++p;
       ++q;
     }

@@ -15,8 +15,16 @@
 //     D_k = M_k + sum over child joints c of J_ck^T K_c^-1 J_ck,      K_k = J_kk D_k^-1 J_kk^T,
 // which are exactly Baraff's D (body node) and -D (joint node) blocks; L_kp = D_k^-1 J_kp is applied
 // implicitly. factor() computes them in one tip-to-base sweep; solve() does one tip-to-base and one
-// base-to-tip sweep. Every block is 6x6, 6x3 or 3x3, so both cost O(n). A leaf (a body with no child
-// joint) has D = M, whose inverse needs no work: its blocks are formed and used in that short form.
+// base-to-tip sweep. Every block is 6x6, 6x3 or 3x3, so both cost O(n).
+//
+// D_k is not inverted as it stands but at the joint point (the articulated-body form of a ball joint):
+// in the coordinates u' = (v_j, w) = X u, v_j = v + w x r the velocity of the joint point, J_kk = [E, 0]
+// and D' = X^-T D X^-1 = [A, B'; B'^T, C'] with A = m E + A_folded, B' = A [r]x + B_folded, and C' the
+// inertia about the joint point. Then K^-1 = A - P B'^T with P = B' C'^-1 (a Schur complement), so one 3x3
+// inverse per body (C'^-1) gives K^-1 without inverting K, and what the solves need is C'^-1, P and K^-1
+// (27 numbers per body). Where the joint point is far from the centre of mass against the body's own
+// inertia (m |r|^2 / I ~ 1e3..1e5 for the presets' and generated mobiles' bodies) the Schur complement
+// loses that factor of the 16 digits: still within 1e-11 relative, far below the joint tolerance.
 // The arrays are sized once; nothing allocates after construction.
 
 #include <vector>
@@ -41,16 +49,17 @@ using Mat63 = Eigen::Matrix<double, 6, 3>;
 // The non-zero part of L^-1 [F; 0] for three wrench columns F applied at one or two bodies, where
 // H = L D L^T is TreeSolver's factorization: only the body and joint nodes on the paths from those bodies
 // to the base are non-zero (eliminating a node touches only its parent). Entries are stored per node,
-// nodes in decreasing index order (tip to base). Because H^-1 = L^-T D^-1 L^-1,
-//     F1^T H^-1 F2 = sum over nodes on both paths of  g1^T D_i^-1 g2  -  j1^T K_i^-1 j2
-// (the joint nodes' pivots are -K_i), which TreeSolver::coupling() evaluates in O(common path length).
+// nodes in decreasing index order (tip to base). Because H^-1 = L^-T D^-1 L^-1 and, at the joint point,
+//     g1^T D_i^-1 g2 - j1^T K_i^-1 j2 = h1^T C_i'^-1 h2      (j = -J_ii D_i^-1 g the joint-node entry),
+// with h = g_torque - r x g_force the node's torque about its joint point, the pivots of the body and
+// joint nodes together leave only the torques:
+//     F1^T H^-1 F2 = sum over nodes on both paths of  h1^T C_i'^-1 h2,
+// which TreeSolver::coupling() evaluates in O(common path length).
 struct PathColumns {
   std::vector<int> node;        // body (and its parent joint) indices, decreasing
-  std::vector<Mat63> g;         // body-node entries: the wrench gathered at the body (N s, N m s), world
-  std::vector<Mat63> y;         // D_i^-1 g: the body's velocity change with its parent joint held (m/s, rad/s)
-  std::vector<Mat3> a;          // K_i^-1 j, j = -J_ii y the joint-node entries (joint impulse, N s)
-  std::vector<Mat3> j;          // joint-node entries: minus the joint point's velocity change (m/s)
-  void clear() { node.clear(); g.clear(); y.clear(); a.clear(); j.clear(); }
+  std::vector<Mat3> h;          // the wrench gathered at the body, as torque about its joint point (N m s)
+  std::vector<Mat3> e;          // C'^-1 h: the body's turn with its joint point held (rad/s)
+  void clear() { node.clear(); h.clear(); e.clear(); }
 };
 
 class TreeSolver {
@@ -143,21 +152,27 @@ class TreeSolver {
   // The deepest the folding stack gets for this order of the bodies, or -1 if the order does not allow
   // it (see stack_folding_possible()).
   static int folding_stack_depth(const std::vector<int>& parent);
-  // Tip to base: y_i = D_i^-1 g_i and the joint terms a_i (with f = 0 if !kWithForces).
+  // Tip to base: y_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
   void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
-  // Base to tip: lambda_i = a_i - K_i^-1 J_ip u_p, u_i = y_i + W_i lambda_i, handed to visit.
+  // Base to tip: the joint point's velocity v_j = c_i + (v_p + w_p x s_i) (the joint row), then
+  // lambda_i = a_i + K_i^-1 (v_p + w_p x s_i), w_i = e_i - P_i^T v_j and v_i = v_j - w_i x r_i, handed to
+  // visit. (y_[i] holds (c_i, e_i) from the tip-to-base sweep.)
   template <class Visit>
   void substitute(Visit& visit) {
     const std::vector<int>& parent = model_.parent;
     for (int i = 1; i < n_; ++i) {
       const int p = parent[i];
+      Vec3 joint_velocity = y_[i].head<3>();
       Vec3 lam = a_[i];
       if (p != 0) {
         const Vec3 parent_point_velocity = u_[p].head<3>() + u_[p].tail<3>().cross(parent_arm_[i]);
-        lam += k_inv_[i] * parent_point_velocity;  // J_ip u_p = -(v_p + w_p x s_i)
+        joint_velocity += parent_point_velocity;
+        lam += k_inv_[i] * parent_point_velocity;
       }
-      const Vec6 u = y_[i] + w_[i] * lam;
+      Vec6 u;
+      u.tail<3>() = y_[i].tail<3>() - p_[i].transpose() * joint_velocity;
+      u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
       u_[i] = u;
       visit(i, u, lam);
     }
@@ -166,27 +181,21 @@ class TreeSolver {
   const Model& model_;
   int n_;
   std::vector<char> leaf_;          // body i has no child joint (fixed by the topology)
-  std::vector<double> inverse_mass_;      // 1 / m_i
   std::vector<Vec3> inverse_moments_;     // 1 / principal moments
   std::vector<Mat3> rotation_scratch_;    // factor(State): rotation matrices of the orientations
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
   std::vector<Mat3> inertia_;       // I_i, world
   std::vector<Mat3> inverse_inertia_;  // I_i^-1, world
-  // D_i = [m E + A'; B; B^T I_i + C'] is accumulated from the children's joints in 3x3 blocks during the
-  // tip-to-base sweep (A', B, C' below, reset to zero once used), then inverted through the Schur
-  // complement of A = m E + A' (all 3x3 work).
+  // D_i = [m E + A_f; B_f; B_f^T I_i + C_f] is accumulated from the children's joints in 3x3 blocks during
+  // the tip-to-base sweep (A_f, B_f, C_f below, reset to zero once used), then factored at the joint point
+  // (see the top of this file).
   std::vector<Mat3> sum_a_;         // sum K_c^-1                          (symmetric)
   std::vector<Mat3> sum_b_;         // - sum K_c^-1 [s_c]x
   std::vector<Mat3> sum_c_;         // sum -[s_c]x K_c^-1 [s_c]x           (symmetric)
-  // D_i^-1 in factored form: with T = A^-1 B and S = C - B^T T,
-  //   D^-1 [g1; g2] = [A^-1 g1 - T y2; y2],  y2 = S^-1 (g2 - T^T g1).
-  // A leaf has A^-1 = E/m, T = 0, S^-1 = I^-1 and uses inverse_mass_ and inverse_inertia_ instead.
-  std::vector<Mat3> a_inv_;         // A^-1 (symmetric; interior bodies only)
-  std::vector<Mat3> t_;             // T = A^-1 B (interior bodies only)
-  std::vector<Mat3> s_inv_;         // S^-1 (symmetric; interior bodies only)
-  std::vector<Mat63> w_;            // W_i = D_i^-1 J_ii^T
-  std::vector<Mat3> k_inv_;         // K_i^-1
+  std::vector<Mat3> c_inv_;         // C'^-1: inverse inertia about the joint point, joints held (symmetric)
+  std::vector<Mat3> p_;             // P = B' C'^-1
+  std::vector<Mat3> k_inv_;         // K_i^-1 = A - P B'^T (symmetric)
   // The stack of stack_folding(): one entry per body whose children have begun to fold into it and that
   // is not done yet (bodies on the path from the sweep's position to the base), at most the tree's depth.
   struct Folded {
@@ -197,8 +206,8 @@ class TreeSolver {
   bool stack_folding_ = false;
   std::vector<Folded> folded_;      // [1, top] in use during a sweep; sized to the deepest it gets
   std::vector<Vec6> g_;             // solve scratch: what the children's joints add to f (zero between solves)
-  std::vector<Vec6> y_;             // solve scratch: D_i^-1 g_i
-  std::vector<Vec3> a_;             // solve scratch: joint terms
+  std::vector<Vec6> y_;             // solve scratch: (c_i, e_i = C'^-1 h_i), h_i = g's torque about the joint point
+  std::vector<Vec3> a_;             // solve scratch: joint terms, a_i = K^-1 c_i + P h_i - g_i's force
   std::vector<Vec6> u_;             // solve scratch: the solution (u_[0] = 0: the fixed component)
 };
 
