@@ -23,8 +23,10 @@
 // inertia about the joint point. Then K^-1 = A - P B'^T with P = B' C'^-1 (a Schur complement), so one 3x3
 // inverse per body (C'^-1) gives K^-1 without inverting K, and what the solves need is C'^-1, P and K^-1
 // (27 numbers per body). Where the joint point is far from the centre of mass against the body's own
-// inertia (m |r|^2 / I ~ 1e3..1e5 for the presets' and generated mobiles' bodies) the Schur complement
-// loses that factor of the 16 digits: still within 1e-11 relative, far below the joint tolerance.
+// inertia, the Schur complement loses up to the factor m |r|^2 / I_min in relative precision: at most 180
+// on the presets' bodies and 1.9e4 / 4.2e4 / 7.6e4 on generated mobiles of 127 / 1023 / 8191 components
+// (seed 1; their light bars hanging off-centre), so K^-1 stays within ~1e-11 relative, far below what the
+// Newton corrections and the joint tolerance need.
 // The arrays are sized once; nothing allocates after construction.
 
 #include <vector>
