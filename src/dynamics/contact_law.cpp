@@ -25,32 +25,31 @@ using Mat3d = Eigen::Matrix3d;
 // The impulse that changes the contact velocity by `change` through the (symmetric, positive
 // semi-definite) block K: K^-1 change, or, when K is singular, the least-squares impulse of least norm
 // (K's pseudo-inverse): the part of `change` no impulse can produce is left out instead of being bought
-// with an unbounded impulse. Factored once per contact and solve (the block does not change between
-// Gauss-Seidel sweeps).
+// with an unbounded impulse. Formed once per contact and solve (the block does not change between
+// Gauss-Seidel sweeps) as a matrix, K^-1 by LDL^T solves of the unit vectors or the pseudo-inverse, so
+// that a sweep's solve is one 3x3 product.
 class BlockSolver {
  public:
-  explicit BlockSolver(const Mat3d& K) : ldlt_(K) {
-    const Vec3d pivots = ldlt_.vectorD().cwiseAbs();
-    regular_ = ldlt_.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff();
-    if (regular_) return;
+  explicit BlockSolver(const Mat3d& K) {
+    const Eigen::LDLT<Mat3d> ldlt(K);
+    const Vec3d pivots = ldlt.vectorD().cwiseAbs();
+    if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff()) {
+      inverse_ = ldlt.solve(Mat3d::Identity());
+      return;
+    }
     Eigen::SelfAdjointEigenSolver<Mat3d> eigen;
     eigen.computeDirect(K);
-    vectors_ = eigen.eigenvectors();
-    values_ = eigen.eigenvalues();
+    const Mat3d& vectors = eigen.eigenvectors();
+    const Vec3d& values = eigen.eigenvalues();
+    const double cutoff = kSingularBlock * values.cwiseAbs().maxCoeff();
+    Vec3d inverse_values;
+    for (int k = 0; k < 3; ++k) inverse_values[k] = values[k] > cutoff ? 1.0 / values[k] : 0.0;
+    inverse_ = vectors * inverse_values.asDiagonal() * vectors.transpose();
   }
-  Vec3d solve(const Vec3d& change) const {
-    if (regular_) return ldlt_.solve(change);
-    const double cutoff = kSingularBlock * values_.cwiseAbs().maxCoeff();
-    Vec3d in_eigenbasis = vectors_.transpose() * change;
-    for (int k = 0; k < 3; ++k) in_eigenbasis[k] = values_[k] > cutoff ? in_eigenbasis[k] / values_[k] : 0.0;
-    return vectors_ * in_eigenbasis;
-  }
+  Vec3d solve(const Vec3d& change) const { return inverse_ * change; }
 
  private:
-  Eigen::LDLT<Mat3d> ldlt_;
-  bool regular_ = true;
-  Mat3d vectors_ = Mat3d::Identity();
-  Vec3d values_ = Vec3d::Zero();
+  Mat3d inverse_;  // K^-1, or K's pseudo-inverse when K is singular
 };
 
 // The impulse of one contact (in its basis) given the velocity it would have without its own impulse.

@@ -37,7 +37,6 @@ Vec3 relative_velocity(const Contact& c, const Vec3& arm_a, const Vec3& arm_b, c
 ContactResponse::ContactResponse(const Model& model)
     : model_(model),
       wrench_(model.count, Vec6::Zero()),
-      zero_rows_(model.count, Vec3::Zero()),
       du_(model.count, Vec6::Zero()) {}
 
 void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
@@ -52,8 +51,11 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   }
   // The solver ignores body 0 (fixed) and keeps every joint's velocity constraint (c = 0).
   wrench_[0].setZero();
-  // (Only the bodies touched above are non-zero; reset them after the solve.)
-  solver_->solve(wrench_, zero_rows_, du_);
+  // Only the bodies touched above are non-zero (the elimination needs only their paths); reset them
+  // after the solve.
+  touched_.clear();
+  for (const Contact& c : contacts) touched_.push_back(c.a), touched_.push_back(c.b);
+  solver_->solve_sparse(wrench_, touched_, du_);
   for (const Contact& c : contacts) {
     wrench_[c.a].setZero();
     wrench_[c.b].setZero();

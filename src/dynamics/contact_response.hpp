@@ -113,7 +113,7 @@ class ContactResponse {
   Eigen::MatrixXd K_;
   Eigen::VectorXd u_, P_;
   std::vector<Vec6> wrench_;   // per body, zero between uses
-  std::vector<Vec3> zero_rows_;
+  std::vector<int> touched_;   // the bodies wrench_ is non-zero at (each contact's two)
   std::vector<Vec6> du_;
 };
 

@@ -72,7 +72,8 @@ TreeSolver::TreeSolver(const Model& model)
       g_(n_, Vec6::Zero()),
       y_(n_, Vec6::Zero()),
       a_(n_, Vec3::Zero()),
-      u_(n_, Vec6::Zero()) {
+      u_(n_, Vec6::Zero()),
+      on_path_(n_, 0) {
   for (int i = 1; i < n_; ++i) {
     if (model.parent[i] > 0) leaf_[model.parent[i]] = 0;
     inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
@@ -282,6 +283,36 @@ void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, s
   } else {
     solve_visiting(f, c, [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
   }
+}
+
+void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>& bodies, std::vector<Vec6>& u) {
+  const std::vector<int>& parent = model_.parent;
+  for (int b : bodies)
+    for (int i = b; i > 0 && !on_path_[i]; i = parent[i]) {
+      on_path_[i] = 1;
+      path_.push_back(i);
+    }
+  std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
+  for (const int i : path_) {  // eliminate<true> with c = 0
+    const Vec3& r = child_arm_[i];
+    const Vec6 g = g_[i] + f[i];
+    g_[i].setZero();
+    const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
+    y_[i].head<3>().setZero();
+    y_[i].tail<3>() = c_inv_[i] * h;
+    const Vec3 a = p_[i] * h - g.head<3>();
+    a_[i] = a;
+    const int p = parent[i];
+    if (p != 0) {
+      g_[p].head<3>() -= a;
+      g_[p].tail<3>() -= parent_arm_[i].cross(a);
+    }
+  }
+  u[0].setZero();
+  const auto store = [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; };
+  substitute<true>(store);
+  for (const int i : path_) on_path_[i] = 0;
+  path_.clear();
 }
 
 void TreeSolver::eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_b, const Mat63& wrench_b,

@@ -114,6 +114,13 @@ class TreeSolver {
   // `lambda` may be the same array as `c`.
   void solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, std::vector<Vec6>& u,
              std::vector<Vec3>* lambda = nullptr);
+  // solve() with c = 0 for wrenches f that are zero except at the bodies listed (repeats and 0 allowed):
+  // the tip-to-base sweep visits only the bodies on their paths to the base (elsewhere g = 0, so y and the
+  // joint term are 0); the base-to-tip sweep visits all, as it must (an impulse anywhere moves the whole
+  // tree). The same result as solve(f, 0, u) (equal as numbers; a zero may differ in sign). For contact
+  // impulses, which act on a few bodies.
+  void solve_sparse(const std::vector<Vec6>& f, const std::vector<int>& bodies, std::vector<Vec6>& u);
+
   // solve() handing each body's result to visit(i, u_i, lambda_i) instead of storing it, for i = 1, 2,
   // ... (parents before children), so that a caller's own per-body pass can run inside the base-to-tip
   // sweep: one pass over the bodies instead of two, which matters when the arrays outgrow the caches.
@@ -159,21 +166,24 @@ class TreeSolver {
   void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
   // Base to tip: the joint point's velocity v_j = c_i + (v_p + w_p x s_i) (the joint row), then
   // lambda_i = a_i + K_i^-1 (v_p + w_p x s_i), w_i = e_i - P_i^T v_j and v_i = v_j - w_i x r_i, handed to
-  // visit. (y_[i] holds (c_i, e_i) from the tip-to-base sweep.)
-  template <class Visit>
+  // visit. (y_[i] holds (c_i, e_i) from the tip-to-base sweep.) kSparse: y_ and a_ hold values only where
+  // on_path_ is set (solve_sparse), and are taken as zero elsewhere.
+  template <bool kSparse = false, class Visit>
   void substitute(Visit& visit) {
     const std::vector<int>& parent = model_.parent;
     for (int i = 1; i < n_; ++i) {
       const int p = parent[i];
-      Vec3 joint_velocity = y_[i].head<3>();
-      Vec3 lam = a_[i];
+      const bool given = !kSparse || on_path_[i];
+      Vec3 joint_velocity = given ? Vec3(y_[i].head<3>()) : Vec3::Zero();
+      Vec3 lam = given ? a_[i] : Vec3::Zero();
+      const Vec3 turn = given ? Vec3(y_[i].tail<3>()) : Vec3::Zero();
       if (p != 0) {
         const Vec3 parent_point_velocity = u_[p].head<3>() + u_[p].tail<3>().cross(parent_arm_[i]);
         joint_velocity += parent_point_velocity;
         lam += k_inv_[i] * parent_point_velocity;
       }
       Vec6 u;
-      u.tail<3>() = y_[i].tail<3>() - p_[i].transpose() * joint_velocity;
+      u.tail<3>() = turn - p_[i].transpose() * joint_velocity;
       u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
       u_[i] = u;
       visit(i, u, lam);
@@ -211,6 +221,8 @@ class TreeSolver {
   std::vector<Vec6> y_;             // solve scratch: (c_i, e_i = C'^-1 h_i), h_i = g's torque about the joint point
   std::vector<Vec3> a_;             // solve scratch: joint terms, a_i = K^-1 c_i + P h_i - g_i's force
   std::vector<Vec6> u_;             // solve scratch: the solution (u_[0] = 0: the fixed component)
+  std::vector<char> on_path_;       // solve_sparse scratch: body i is on a listed body's path (0 between solves)
+  std::vector<int> path_;           // solve_sparse scratch: those bodies
 };
 
 // The symmetric KKT matrix H = [M J^T; J 0] written out densely (moving bodies 1..n-1 as 6-blocks, then
