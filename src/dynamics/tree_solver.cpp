@@ -78,6 +78,7 @@ TreeSolver::TreeSolver(const Model& model)
     if (model.parent[i] > 0) leaf_[model.parent[i]] = 0;
     inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
   }
+  path_.reserve(n_);  // solve_sparse: at most every body (nothing allocates after construction)
   set_stack_folding(n_ >= kStackFoldingBodies);
 }
 
