@@ -4,6 +4,10 @@
 //                        (issue 2's figure): presets from mobiles/ and generated mobiles of 15 ... 65535
 //                        components
 //   BM_StepCollisions/<mobile>  the same with collisions on (issue 3's figure)
+//   BM_StepSpan/<mobile>/off, .../on  the same over a fixed number of steps (span_steps), so that with
+//                        collisions off and on the same motion is timed: BM_Step and BM_StepCollisions
+//                        step on for as long as --benchmark_min_time asks, and the swing changes along
+//                        the way (docs/performance.md, "The benchmark's span matters")
 //   BM_Factor/<mobile>   TreeSolver::factor() at a swinging pose
 //   BM_Solve/<mobile>    TreeSolver::solve() with the factorization of that pose
 //
@@ -113,6 +117,16 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions) {
   }
 }
 
+// BM_StepSpan's fixed number of steps (1 ms each) from the swinging state: a few simulated seconds
+// where that takes seconds to time, so that knocks and quiet stretches both count.
+int span_steps(int components) {
+  if (components <= 15) return 20000;
+  if (components <= 127) return 10000;
+  if (components <= 1023) return 5000;
+  if (components <= 8191) return 2000;
+  return 30;
+}
+
 void BM_Factor(benchmark::State& state, const std::string& key) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
@@ -179,6 +193,14 @@ void register_all() {
   for (const std::string& key : keys)
     benchmark::RegisterBenchmark(("BM_StepCollisions/" + key).c_str(), BM_Step, key, true)
         ->Unit(benchmark::kMicrosecond);
+  for (const std::string& key : keys) {
+    const int components = key.rfind("generated-", 0) == 0 ? std::stoi(key.substr(10)) : 10;
+    for (const bool collisions : {false, true})
+      benchmark::RegisterBenchmark(("BM_StepSpan/" + key + (collisions ? "/on" : "/off")).c_str(), BM_Step, key,
+                                   collisions)
+          ->Iterations(span_steps(components))
+          ->Unit(benchmark::kMicrosecond);
+  }
   for (const std::string& key : keys)
     benchmark::RegisterBenchmark(("BM_Factor/" + key).c_str(), BM_Factor, key)->Unit(benchmark::kMicrosecond);
   for (const std::string& key : keys)
