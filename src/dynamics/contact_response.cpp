@@ -196,6 +196,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     }
     report.friction_dropped = true;
   }
+  report.friction_dropped = report.friction_dropped || law.friction_dropped;
   report.iterations = law.iterations;
   report.sticking = law.sticking;
   report.sliding = law.sliding;

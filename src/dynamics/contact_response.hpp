@@ -54,8 +54,9 @@ struct ContactStepReport {
   int sliding = 0;
   int iterations = 0;          // Gauss-Seidel sweeps of the contact law
   bool restitution_dropped = false;  // Newton restitution would have added energy: solved with e = 0
-  bool friction_dropped = false;     // the law with friction added energy (nearly dependent contacts):
-                                     // solved frictionless, or with no impulse if that gained too
+  bool friction_dropped = false;     // the law with friction did not converge, or added energy (nearly
+                                     // dependent contacts): solved frictionless, or with no impulse if
+                                     // that gained too
   double energy_change = 0;    // J, kinetic energy the impulses changed (<= 0 up to round-off)
   double deepest = 0;          // m, largest overlap among the contacts (>= 0)
 };
