@@ -143,8 +143,8 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   if (!converged) {
     // Block Gauss-Seidel with friction need not converge: contacts coupled through one body can keep
     // trading sticking for sliding (ContactLaw.DependentContactsMeetTheLaw: a body landing on four corners,
-    // 1 to 7 of 50 landings for friction coefficients 0.3 to 5). What it stops at can leave a contact
-    // approaching at a good part of its speed (0.08 of 1-3 m/s there). The normal law alone is a convex problem that converges; its impulses
+    // a few of 50 landings for friction coefficients 0.3 to 5). What it stops at can leave a contact
+    // approaching (up to 0.08 m/s of 1-3 m/s there). The normal law alone is a convex problem that converges; its impulses
     // are used instead, without friction for this solve.
     const auto normal = Eigen::seqN(0, m, 3);
     Eigen::VectorXd target(m), pn;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "aloft/math.hpp"
@@ -259,10 +261,12 @@ TEST(ContactLaw, DependentContactsMeetTheLaw) {
   // A body landing on an immovable floor at four corners: 12 contact rows on the body's 6 freedoms, so
   // K is singular and the corners' impulses are not unique. Whatever the friction, after the solve every
   // corner meets the law: no approach, no push while separating, the impulse inside the cone. With
-  // friction, block Gauss-Seidel did not converge for some landings (4, 7 and 1 of 50 at mu = 0.3, 1 and
-  // 5, none without friction: contacts trading sticking for sliding) and returned corners still
-  // approaching at up to 0.08 m/s; those now get the frictionless normal law's impulses.
+  // friction, block Gauss-Seidel does not converge for some landings (2, 4 and 0 of these 50 at mu = 0.3,
+  // 1 and 5, none without friction: contacts trading sticking for sliding; 4, 7 and 1 in another draw)
+  // and returned corners still approaching (0.009-0.013 m/s here, up to 0.08 m/s in the other draw);
+  // those now get the frictionless normal law's impulses.
   for (const double mu : {0.0, 0.3, 1.0, 5.0}) {
+    std::srand(31);  // Quat::UnitRandom (random_body) draws from std::rand
     std::mt19937 rng(31);
     int dropped = 0;
     for (int trial = 0; trial < 50; ++trial) {
@@ -296,8 +300,10 @@ TEST(ContactLaw, DependentContactsMeetTheLaw) {
       }
       EXPECT_LE(r.energy_change, 1e-12 * std::abs(u.dot(P)));
     }
-    // The fallback is the exception: at most the landings Gauss-Seidel could not settle (7 of 50).
-    EXPECT_LE(dropped, 7) << "mu " << mu;
+    // The fallback stays the exception, so that friction acts in most landings: measured 0 / 2 / 4 / 0 of
+    // 50 at mu = 0 / 0.3 / 1 / 5 with this seed; a quarter would mean Gauss-Seidel itself got worse.
+    EXPECT_LE(dropped, 12) << "mu " << mu;
+    std::printf("mu %.1f: %d of 50 landings solved without friction\n", mu, dropped);
   }
 }
 
