@@ -11,13 +11,13 @@ namespace {
 // contact velocity changed in a sweep by more than this fraction of the largest velocity or target
 // (whichever comes first); a single contact is exact after one pass (checked by the second). The second
 // test ends what the first cannot: where the contacts' rows are dependent (a wire lying on a plate at
-// several points, 3 rows each, against the pair's 6 relative freedoms) K is singular, and Gauss-Seidel
-// moves the impulses along K's null space, which changes no velocity and no motion (G^T n = 0), without
-// end. On generated-127 swinging with collisions (BM_StepCollisions, --benchmark_min_time=0.3), 883 of
-// 11,091 solves ran into kMaxSweeps with the impulse test alone (341,225 sweeps in all), 188 of 11,276
-// with both (157,628 sweeps). Those left are contacts sliding against each other whose slip directions
-// keep changing (impulses still changing by 1e-5..0.8 of their size after 200 sweeps); the caller's energy
-// check (ContactResponse::resolve) guards what they return.
+// several points, 3 rows each, against the pair's 6 relative freedoms) K is singular or nearly so, and
+// Gauss-Seidel can go on moving the impulses along (or near) K's null space, which changes no velocity
+// and no motion (G^T n = 0), after the velocities have settled. On generated-127 swinging with collisions
+// (BM_StepCollisions, --benchmark_min_time=0.3), 883 of 11,091 solves ran into kMaxSweeps with the
+// impulse test alone (341,225 sweeps in all), 188 of 11,276 with both (157,628 sweeps). Those left are
+// contacts sliding against each other whose slip directions keep changing (impulses still changing by
+// 1e-5..0.8 of their size after 200 sweeps): they take the normal law's impulses (solve_contact_law).
 constexpr double kRelativeChange = 1e-13;
 constexpr int kMaxSweeps = 200;
 // A slip speed (m/s) below this has no reliable direction; the sticking impulse's direction is used.
