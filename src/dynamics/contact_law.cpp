@@ -146,12 +146,9 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
     // a few of 50 landings for friction coefficients 0.3 to 5). What it stops at can leave a contact
     // approaching (up to 0.08 m/s of 1-3 m/s there). The normal law alone is a convex problem that converges; its impulses
     // are used instead, without friction for this solve.
-    const auto normal = Eigen::seqN(0, m, 3);
-    Eigen::VectorXd target(m), pn;
+    Eigen::VectorXd target(m);
     for (int k = 0; k < m; ++k) target[k] = rows[k].target_normal;
-    solve_normal_law(K(normal, normal), u(normal), target, pn);
-    P.setZero();
-    P(normal) = pn;
+    solve_frictionless_law(K, u(Eigen::seqN(0, m, 3)), target, P);
     result.friction_dropped = true;
     result.energy_change = contact_energy_change(K, u, P);
     return result;
@@ -191,6 +188,16 @@ void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, c
         (velocity - sweep_start).cwiseAbs().maxCoeff() <= kRelativeChange * velocity_scale)
       break;
   }
+}
+
+void solve_frictionless_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,
+                            Eigen::VectorXd& P) {
+  const int m = static_cast<int>(u_n.size());
+  const auto normal = Eigen::seqN(0, m, 3);  // the normal row of each contact
+  Eigen::VectorXd P_n;
+  solve_normal_law(K(normal, normal), u_n, target, P_n);
+  P = Eigen::VectorXd::Zero(3 * m);
+  P(normal) = P_n;
 }
 
 double contact_energy_change(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const Eigen::VectorXd& P) {

@@ -43,6 +43,11 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
 void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,
                       Eigen::VectorXd& P_n);
 
+// The same on the whole 3m x 3m K (normal rows first in each contact's basis): P (resized to 3m) has the
+// normal law's impulses in the normal rows and no friction. u_n and target are per contact (m).
+void solve_frictionless_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,
+                            Eigen::VectorXd& P);
+
 // The change of kinetic energy (J) impulses P make on a system whose contact velocities are u and
 // collision matrix K: u^T P + P^T K P / 2 (exact for any mechanical system whose velocities satisfy its
 // joints before the impulse).

@@ -62,15 +62,6 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   }
 }
 
-void ContactResponse::solve_frictionless(int m, const Eigen::VectorXd& un, const Eigen::VectorXd& target,
-                                         Eigen::VectorXd& P) const {
-  const auto normal = Eigen::seqN(0, m, 3);  // the normal row of each contact
-  Eigen::VectorXd Pn;
-  solve_normal_law(K_(normal, normal), un, target, Pn);
-  P = Eigen::VectorXd::Zero(3 * m);
-  P(normal) = Pn;
-}
-
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
                                            const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
@@ -186,7 +177,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     set_targets(false);
     Eigen::VectorXd target(m);
     for (int k = 0; k < m; ++k) target[k] = rows_[k].target_normal;
-    solve_frictionless(m, u_(Eigen::seqN(0, m, 3)), target, P_);
+    solve_frictionless_law(K_, u_(Eigen::seqN(0, m, 3)), target, P_);
     law.sticking = 0;
     law.sliding = 0;
     law.energy_change = contact_energy_change(K_, u_, P_);
@@ -224,7 +215,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   }
   if (penetrating) {
     Eigen::VectorXd P;
-    solve_frictionless(m, Eigen::VectorXd::Zero(m), target, P);
+    solve_frictionless_law(K_, Eigen::VectorXd::Zero(m), target, P);
     respond(contacts, P);
     for (int i = 0; i < model_.count; ++i) pseudo[i] = i == 0 ? Vec6::Zero() : du_[i];
     has_pseudo = true;

@@ -99,9 +99,6 @@ class ContactResponse {
  private:
   // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_.
   void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
-  // Frictionless impulses for the m contacts of K_: the normal law (solve_normal_law) on K_'s normal rows
-  // and columns, for normal velocities `un` and targets `target` (m each). P: 3m, tangential parts zero.
-  void solve_frictionless(int m, const Eigen::VectorXd& un, const Eigen::VectorXd& target, Eigen::VectorXd& P) const;
 
   const Model& model_;
   TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose
