@@ -81,6 +81,11 @@ class CollisionDetector {
   const CollisionPairs& pairs() const;
   // Largest distance (m) from component i's centre of mass to its surface; 0 for one without shapes.
   double reach(int component) const;
+  // Component i's share of a pair's margin (m) when find_contacts is called with `step` and
+  // `base_margin` and i moves at `velocity`, turns at `angular` (world): base_margin / 2 + step (|v| +
+  // |w| reach). keep_within_margin gives what find_contacts would when no component's share is wider
+  // than in the call `found` came from.
+  double margin(int component, const Vec3& velocity, const Vec3& angular, double step, double base_margin) const;
   // Whether piece pairs measured apart are skipped while the components' motion since cannot have
   // closed the gap (on by default; detector.cpp, "Coherence"). It never changes the contacts found, only
   // the time taken: off is for checking that, and for measuring what it saves.

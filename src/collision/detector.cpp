@@ -213,6 +213,11 @@ const CollisionPairs& CollisionDetector::pairs() const { return impl_->pairs; }
 
 double CollisionDetector::reach(int component) const { return impl_->geometry[component].reach; }
 
+double CollisionDetector::margin(int component, const Vec3& velocity, const Vec3& angular, double step,
+                                 double base_margin) const {
+  return component_margin(impl_->geometry[component], velocity, angular, step, base_margin);
+}
+
 void CollisionDetector::set_coherence(bool on) { impl_->coherence = on; }
 
 void CollisionDetector::find_contacts(const State& state, double step, double base_margin,

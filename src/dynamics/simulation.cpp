@@ -272,11 +272,6 @@ bool Simulation::reject_spin(double h) {
 
 namespace {
 
-// A component's speed bound (m/s) as the detector takes it for its margin: |v| + |w| times its reach.
-double detection_speed(const CollisionDetector& detector, int i, const Vec3& v, const Vec3& w) {
-  return v.norm() + w.norm() * detector.reach(i);
-}
-
 // The largest speed (m/s) of a corner of the box [low, high] (body frame of a body at `orientation`,
 // origin at its centre of mass) when the body moves at v and turns at w (world): max |v + w x r| over
 // the 8 corners r. |v + w x r| is convex in r, so this bounds the speed of every point of the box.
@@ -513,13 +508,13 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     // with the slack only after a look whose contacts had impulses, for 405 and 26.
     work.last_look_found = !work.contacts.empty();
     if (contact_report.active > 0) {
-      bool covered = true;
+      bool covered = true;  // no component's margin is wider now than in the look `nearby` came from
       for (int i = 1; i < n; ++i) {
-        const double looked = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
+        const double looked =
+            work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin + 2 * slack);
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
-        const double travel = h * detection_speed(*work.detector, i, probe.velocity[i], probe.angular[i]);
-        covered = covered && travel <= looked + slack;
+        covered = covered && work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin) <= looked;
       }
       if (covered)
         work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
