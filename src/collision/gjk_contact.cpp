@@ -84,12 +84,12 @@ bool gjk_contact(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b,
   // centre, a wire's axis; ConvexPiece::core_support), the radii taken off afterwards. GJK on cores ends
   // in finitely many steps; on a round support it only converges: 27 iterations per call on average for
   // a wire against a plate or a wire's end, against 10-15 for two plates then (generated-127 and 1023
-  // after the breeze; 4-7 since GJK stops on no progress). A sphere is its centre grown by its radius, so the cores give its distance exactly. A
-  // wire lies inside the capsule of its axis and radius, so the cores' distance minus the radii is at
-  // most the pieces' distance: enough to rule the pair out beyond the margin, and equal to it when the
-  // direction between the closest points is across the wire's axis (the point moved out by the radius
-  // is then on its side or the rim of an end). Otherwise an end face of the wire is nearest, and GJK
-  // measures the wire whole.
+  // after the breeze; 4-7 since GJK stops on no progress). A sphere is its centre grown by its radius,
+  // so the cores give its distance exactly. A wire lies inside the capsule of its axis and radius, so
+  // the cores' distance minus the radii is at most the pieces' distance: enough to rule the pair out
+  // beyond the margin, and equal to it when the direction between the closest points is across the
+  // wire's axis (the point moved out by the radius is then on its side or the rim of an end). Otherwise
+  // an end face of the wire is nearest, and GJK measures the wire whole.
   // The gap is taken from GJK's certified lower bound, never from its estimate, which is above the true
   // distance where GJK stops at its iteration limit (by up to millimetres on wires lying along plates):
   // taken as the gap, that hid contacts (estimate beyond the margin, truth within) and, remembered by the

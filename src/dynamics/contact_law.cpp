@@ -144,8 +144,8 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
     // Block Gauss-Seidel with friction need not converge: contacts coupled through one body can keep
     // trading sticking for sliding (ContactLaw.DependentContactsMeetTheLaw: a body landing on four corners,
     // a few of 50 landings for friction coefficients 0.3 to 5). What it stops at can leave a contact
-    // approaching (up to 0.08 m/s of 1-3 m/s there). The normal law alone is a convex problem that converges; its impulses
-    // are used instead, without friction for this solve.
+    // approaching (up to 0.08 m/s of 1-3 m/s there). The normal law alone is a convex problem that
+    // converges; its impulses are used instead, without friction for this solve.
     Eigen::VectorXd target(m);
     for (int k = 0; k < m; ++k) target[k] = rows[k].target_normal;
     solve_frictionless_law(K, u(Eigen::seqN(0, m, 3)), target, P);

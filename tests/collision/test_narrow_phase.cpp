@@ -200,7 +200,8 @@ TEST(NarrowPhase, WireBesideAPlateGetsItsExactDistanceAndNormal) {
   // certified lower bound, was right). Kept: the cases where the axis comes closest strictly inside the
   // thread, so its side is nearest and the reference (segment_to_plate minus the radius) is exact.
   Plate plate;
-  for (int k = 0; k < 6; ++k) plate.points.emplace_back(0.03 * std::cos(1.0471975511965976 * k), 0.03 * std::sin(1.0471975511965976 * k));
+  for (int k = 0; k < 6; ++k)
+    plate.points.emplace_back(0.03 * std::cos(1.0471975511965976 * k), 0.03 * std::sin(1.0471975511965976 * k));
   plate.u_axis = Vec3::UnitX();
   plate.v_axis = Vec3::UnitY();  // in the x-y plane, normal +z
   plate.thickness = 0.002;
