@@ -244,31 +244,39 @@ template void TreeSolver::factor_blocks<true, true>(const std::vector<Mat3>&, co
 template void TreeSolver::factor_blocks<true, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 template void TreeSolver::factor_blocks<false, false>(const std::vector<Mat3>&, const std::vector<Vec6>*);
 
+inline void TreeSolver::fold_into_parent(int i, const Vec3& a) {
+  const int p = model_.parent[i];
+  if (p == 0) return;
+  g_[p].head<3>() -= a;
+  g_[p].tail<3>() -= parent_arm_[i].cross(a);
+}
+
+inline void TreeSolver::eliminate_body(int i, const Vec6& g, const Vec3& c) {
+  const Vec3 h = g.tail<3>() - child_arm_[i].cross(g.head<3>());
+  y_[i].head<3>() = c;
+  y_[i].tail<3>() = c_inv_[i] * h;
+  Vec3 a = k_inv_[i] * c;
+  a += p_[i] * h - g.head<3>();
+  a_[i] = a;
+  fold_into_parent(i, a);
+}
+
 // Tip to base: g_i = f_i + what the child joints added, h_i = g_i's torque about the joint point,
 // y_i = (c_i, C'^-1 h_i), a_i = K_i^-1 c_i + P_i h_i - g_i's force, and g_p += J_ip^T a_i. (g_ is zero
 // between solves: each entry is reset once read.)
 template <bool kWithForces>
 void TreeSolver::eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c) {
-  const std::vector<int>& parent = model_.parent;
   for (int i = n_ - 1; i >= 1; --i) {
-    const Vec3& r = child_arm_[i];
-    y_[i].head<3>() = c[i];
-    Vec3 a = k_inv_[i] * c[i];
-    if (leaf_[i] && !kWithForces) {
-      y_[i].tail<3>().setZero();  // a leaf with no applied wrench: g = 0
+    if (leaf_[i] && !kWithForces) {  // a leaf with no applied wrench: g = 0
+      y_[i].head<3>() = c[i];
+      y_[i].tail<3>().setZero();
+      a_[i] = k_inv_[i] * c[i];
+      fold_into_parent(i, a_[i]);
     } else {
       Vec6 g = g_[i];
       g_[i].setZero();
       if constexpr (kWithForces) g += (*f)[i];
-      const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
-      y_[i].tail<3>() = c_inv_[i] * h;
-      a += p_[i] * h - g.head<3>();
-    }
-    a_[i] = a;
-    const int p = parent[i];
-    if (p != 0) {
-      g_[p].head<3>() -= a;
-      g_[p].tail<3>() -= parent_arm_[i].cross(a);
+      eliminate_body(i, g, c[i]);
     }
   }
 }
@@ -295,19 +303,9 @@ void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>
     }
   std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
   for (const int i : path_) {  // eliminate<true> with c = 0
-    const Vec3& r = child_arm_[i];
     const Vec6 g = g_[i] + f[i];
     g_[i].setZero();
-    const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
-    y_[i].head<3>().setZero();
-    y_[i].tail<3>() = c_inv_[i] * h;
-    const Vec3 a = p_[i] * h - g.head<3>();
-    a_[i] = a;
-    const int p = parent[i];
-    if (p != 0) {
-      g_[p].head<3>() -= a;
-      g_[p].tail<3>() -= parent_arm_[i].cross(a);
-    }
+    eliminate_body(i, g, Vec3::Zero());
   }
   u[0].setZero();
   const auto store = [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; };

@@ -164,6 +164,11 @@ class TreeSolver {
   // Tip to base: y_i and the joint terms a_i (with f = 0 if !kWithForces).
   template <bool kWithForces>
   void eliminate(const std::vector<Vec6>* f, const std::vector<Vec3>& c);
+  // Body i's step of a tip-to-base sweep, for the wrench g gathered at it and its joint row c: y_[i] and
+  // a_[i] (see eliminate()), and J_ip^T a_i added to the parent's g_.
+  void eliminate_body(int i, const Vec6& g, const Vec3& c);
+  // J_ip^T a = -(a, s_i x a) added to the parent's g_ (nothing for a joint to the fixed component).
+  void fold_into_parent(int i, const Vec3& a);
   // Base to tip: the joint point's velocity v_j = c_i + (v_p + w_p x s_i) (the joint row), then
   // lambda_i = a_i + K_i^-1 (v_p + w_p x s_i), w_i = e_i - P_i^T v_j and v_i = v_j - w_i x r_i, handed to
   // visit. (y_[i] holds (c_i, e_i) from the tip-to-base sweep.) kSparse: y_ and a_ hold values only where
