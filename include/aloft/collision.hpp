@@ -69,6 +69,10 @@ struct Contact {
   // not known.
   Vec3 near_low_a = Vec3::Constant(INFINITY), near_high_a = Vec3::Constant(-INFINITY);
   Vec3 near_low_b = Vec3::Constant(INFINITY), near_high_b = Vec3::Constant(-INFINITY);
+  // Whether every pair of convex pieces of a and b found within the margin is a contact of the pair:
+  // false when the pair had more than the detector keeps (it keeps the deepest few), so that a piece
+  // pair within the margin has no contact of its own (Simulation then bounds the pair's travel in full).
+  bool complete = true;
 };
 
 class CollisionDetector {
@@ -101,9 +105,9 @@ class CollisionDetector {
   void find_contacts(const State& state, double step, double base_margin, std::vector<Contact>& contacts);
   // Of `found`, what find_contacts(state, step, base_margin) would give, when `found` came from a call
   // at the same pose whose margins were all at least as wide: the contacts below this margin, in the
-  // same order (a pair's deepest are the same whatever the margin). Their reach and near boxes stay
-  // those of the wider call (at least as large). Lets a caller whose velocities changed after a wider
-  // look skip looking again.
+  // same order (a pair's deepest are the same whatever the margin). Their reach, near boxes and
+  // `complete` stay those of the wider call (at least as large; false where the narrower look might say
+  // true). Lets a caller whose velocities changed after a wider look skip looking again.
   void keep_within_margin(const std::vector<Contact>& found, const State& state, double step, double base_margin,
                           std::vector<Contact>& kept) const;
 

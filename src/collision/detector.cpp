@@ -167,6 +167,7 @@ struct CollisionDetector::Impl {
       low_a = low_a.cwiseMin(f.piece_a->box_low), high_a = high_a.cwiseMax(f.piece_a->box_high);
       low_b = low_b.cwiseMin(f.piece_b->box_low), high_b = high_b.cwiseMax(f.piece_b->box_high);
     }
+    const bool complete = found.size() <= kMaxContactsPerPair;
     if (found.size() > kMaxContactsPerPair) {
       // The deepest, kept in piece order: then a look with a wider margin, which finds more shallow
       // ones, keeps the same contacts in the same order (keep_within_margin).
@@ -177,7 +178,7 @@ struct CollisionDetector::Impl {
     }
     for (const Found& f : found)
       contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b, low_a,
-                          high_a, low_b, high_b});
+                          high_a, low_b, high_b, complete});
   }
 };
 
