@@ -40,12 +40,13 @@ double contact_deepening_bound(const Contact& contact, const ContactSide& a, con
   const double precession_a = 0.5 * h * h * a.precession.norm(), precession_b = 0.5 * h * h * b.precession.norm();
   const double theta_a = h * a.angular.norm() + precession_a, theta_b = h * b.angular.norm() + precession_b;
   const double travel = h * relative_velocity.norm();
-  const double in_b_frame =
-      std::max(0.0, on_a.along) + theta_b * (travel + (theta_a + theta_b) * on_a.farthest + 0.5 * theta_b * on_a.farthest);
-  const double in_a_frame =
-      std::max(0.0, on_b.along) + theta_a * (travel + (theta_a + theta_b) * on_b.farthest + 0.5 * theta_a * on_b.farthest);
+  const double in_b_frame = std::max(0.0, on_a.along) +
+                            theta_b * (travel + (theta_a + 1.5 * theta_b) * on_a.farthest);
+  const double in_a_frame = std::max(0.0, on_b.along) +
+                            theta_a * (travel + (1.5 * theta_a + theta_b) * on_b.farthest);
   // Both frames: each body's arcs and precession.
-  const double curvature = (precession_a + 0.5 * theta_a * theta_a) * a.reach + (precession_b + 0.5 * theta_b * theta_b) * b.reach;
+  const double curvature = (precession_a + 0.5 * theta_a * theta_a) * a.reach +
+                           (precession_b + 0.5 * theta_b * theta_b) * b.reach;
   const double closing =
       approach ? std::max(0.0, -h * relative_velocity.dot(n) - std::max(contact.distance, 0.0)) : 0.0;
   return closing + std::min(in_b_frame, in_a_frame) + curvature;

@@ -14,8 +14,9 @@
 //     h [ v_rel(p) . n + ((w_a - w_b) x (q - p)) . n ] = h [ v_rel(p) . n - (q - p) . (n x (w_a - w_b)) ],
 // so it sinks past Y's plane by at most (approach) max(0, -h v_rel . n - max(d, 0)) plus (turn) the
 // largest of -h (q - p) . (n x (w_a - w_b)) over X. That is linear in q: its largest value over a box
-// around X is at a corner, and it is the same expression for Y's points sinking past X's plane as seen
-// from a's frame, so the smaller of the two boxes' values bounds both. A translation that does not
+// around X is at a corner. It is the same expression for Y's points sinking past X's plane as seen from
+// a's frame, over a box around Y; the overlap along either plane's normal bounds the pieces'
+// penetration depth, so the smaller of the two boxes' values does too. A translation that does not
 // approach at p cannot make convex pieces overlap more than they do (it keeps X on its side of a plane
 // Y is on the other side of), and a turn about the contact normal (a plate spinning flat against a
 // wire) moves nothing towards the plane: neither counts, where a bound on how far any point travels

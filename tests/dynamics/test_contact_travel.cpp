@@ -39,7 +39,8 @@ struct Box {
     std::array<Vec3, 8> c;
     const Mat3 r = orientation.toRotationMatrix();
     for (int k = 0; k < 8; ++k)
-      c[k] = position + r * Vec3(k & 1 ? half.x() : -half.x(), k & 2 ? half.y() : -half.y(), k & 4 ? half.z() : -half.z());
+      c[k] = position +
+             r * Vec3(k & 1 ? half.x() : -half.x(), k & 2 ? half.y() : -half.y(), k & 4 ? half.z() : -half.z());
     return c;
   }
   // The drift of Simulation (rattle's step 2): x' = x + h v; q' = exp(h w_m) q, w_m = I(q_m)^-1 I(q) w at
@@ -167,16 +168,19 @@ TEST(ContactTravel, BoundsTheOverlapAfterTheDrift) {
     ASSERT_LE(excess, 1e-12) << "trial " << trial << ": overlap " << after << " m after, distance "
                              << s.contact.distance << " m before, bound " << bound << " m";
     worst_excess = std::max(worst_excess, excess);
+    const bool turning_only = contact_deepening_bound(s.contact, s.a.side(), s.b.side(), kStep, false) == bound;
     if (after > std::max(0.0, -s.contact.distance) + 1e-6) {
       ++deepened;
-      tightest = std::max(tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
+      if (turning_only) tightest = std::max(tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
     }
   }
-  // The test must probe the bound, not pass far below it: many trials deepen, and the deepest of them
-  // comes near the bound (first-order terms are exact; the rest is the curvature allowance).
+  // The test must probe the bound, not pass far below it: many trials deepen, and where no approach
+  // counts (the deepening is the turn's alone, which the bound takes to first order exactly) the deepest
+  // comes near the bound: the curvature allowance is generous, not loose.
   EXPECT_GT(deepened, 2000);
   EXPECT_GT(tightest, 0.5);
-  std::printf("deepened %d of 20000; largest deepening / bound %.3f; closest approach to the bound %.3g m\n",
+  std::printf("deepened %d of 20000; largest deepening / bound where only turns count %.3f; closest approach to "
+              "the bound %.3g m\n",
               deepened, tightest, worst_excess);
 }
 
@@ -192,7 +196,8 @@ TEST(ContactTravel, ATranslationCountsOnlyItsApproach) {
     EXPECT_NEAR(bound, std::max(0.0, 4e-4 - std::max(gap, 0.0)), 1e-15) << "gap " << gap;
     EXPECT_NEAR(overlap_after(s, kStep), -gap + 4e-4, 1e-12) << "gap " << gap;
     s.a.velocity = 1.0 * rb.col(0);
-    EXPECT_NEAR(contact_deepening_bound(s.contact, s.a.side(), s.b.side(), kStep, true), 0.0, 1e-15);  // rounding of n . v
+    // Zero but for the rounding of n . v (1 m/s along a tangent).
+    EXPECT_NEAR(contact_deepening_bound(s.contact, s.a.side(), s.b.side(), kStep, true), 0.0, 1e-15);
   }
 }
 
