@@ -69,6 +69,10 @@ struct Contact {
   // not known.
   Vec3 near_low_a = Vec3::Constant(INFINITY), near_high_a = Vec3::Constant(-INFINITY);
   Vec3 near_low_b = Vec3::Constant(INFINITY), near_high_b = Vec3::Constant(-INFINITY);
+  // m: the smallest half-width (half the smallest width: a wire's radius, half a plate's thickness) of
+  // the pieces of a and b found within the margin: how deep a contact of the pair can get before it is
+  // nearer the far side of a piece than the near one. Infinite when not known.
+  double thinnest = INFINITY;
   // Whether every pair of convex pieces of a and b found within the margin is a contact of the pair:
   // false when the pair had more than the detector keeps (it keeps the deepest few), so that a piece
   // pair within the margin has no contact of its own (Simulation then bounds the pair's travel in full).

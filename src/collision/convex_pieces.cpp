@@ -34,6 +34,32 @@ ConvexPiece polytope(int shape, std::vector<Vec3> vertices) {
 
 // The enclosing sphere of a piece: centre at the middle of its axis-aligned bounds, radius the exact
 // farthest distance from there.
+// Half the piece's smallest width (m; see ConvexPiece::half_width). A polytope's smallest width is
+// across one of its face normals or across the cross product of two of its edge directions; its axes and
+// edges (the faces' normals are crosses of their edges) give them all.
+double smallest_half_width(const ConvexPiece& piece) {
+  switch (piece.kind) {
+    case ConvexPiece::Kind::Sphere:
+      return piece.radius;
+    case ConvexPiece::Kind::Cylinder:
+      return std::min(piece.radius, 0.5 * (piece.b - piece.a).norm());
+    case ConvexPiece::Kind::Polytope: {
+      double smallest = INFINITY;
+      const auto across = [&](const Vec3& d) {
+        smallest = std::min(smallest, 0.5 * (piece.support(d).dot(d) - piece.support(-d).dot(d)));
+      };
+      for (const Vec3& axis : piece.axes) across(axis);
+      for (std::size_t i = 0; i < piece.edges.size(); ++i)
+        for (std::size_t j = i + 1; j < piece.edges.size(); ++j) {
+          const Vec3 normal = piece.edges[i].cross(piece.edges[j]);
+          if (normal.norm() > 1e-6) across(normal.normalized());
+        }
+      return smallest;
+    }
+  }
+  return 0;
+}
+
 Bounds set_bounds(ConvexPiece& piece) {
   Bounds box;
   switch (piece.kind) {
@@ -56,6 +82,7 @@ Bounds set_bounds(ConvexPiece& piece) {
   piece.box_low = box.min;
   piece.box_high = box.max;
   piece.reach = piece.farthest_distance(Vec3::Zero());
+  piece.half_width = smallest_half_width(piece);
   return box;
 }
 

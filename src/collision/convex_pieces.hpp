@@ -45,6 +45,10 @@ struct ConvexPiece {
   double bound_radius = 0;
   Vec3 box_low = Vec3::Zero(), box_high = Vec3::Zero();  // a box enclosing it, body axes (body frame, m)
   double reach = 0;                  // m: largest distance from the centre of mass (body origin) to the piece
+  // m: half the piece's smallest width (a sphere's or a wire's radius, half a plate's thickness): how deep
+  // another piece can get into it before it is nearer the far side (Simulation's limit on how much deeper
+  // pieces in contact may get in a step is a fraction of it).
+  double half_width = 0;
 
   // The point of the piece farthest along `direction` (body frame; direction need not be unit).
   Vec3 support(const Vec3& direction) const;

@@ -156,14 +156,16 @@ struct CollisionDetector::Impl {
         }
       }
     }
-    // Every contact of the pair carries the largest reach, and a box around, all the pieces found near
-    // each other, including any the cut below drops (their travel must be bounded too).
-    double reach_a = 0, reach_b = 0;
+    // Every contact of the pair carries the largest reach, a box around and the smallest half-width of
+    // all the pieces found near each other, including any the cut below drops (their travel must be
+    // bounded too).
+    double reach_a = 0, reach_b = 0, thinnest = INFINITY;
     Vec3 low_a = Vec3::Constant(INFINITY), high_a = Vec3::Constant(-INFINITY);
     Vec3 low_b = low_a, high_b = high_a;
     for (const Found& f : found) {
       reach_a = std::max(reach_a, f.piece_a->reach);
       reach_b = std::max(reach_b, f.piece_b->reach);
+      thinnest = std::min({thinnest, f.piece_a->half_width, f.piece_b->half_width});
       low_a = low_a.cwiseMin(f.piece_a->box_low), high_a = high_a.cwiseMax(f.piece_a->box_high);
       low_b = low_b.cwiseMin(f.piece_b->box_low), high_b = high_b.cwiseMax(f.piece_b->box_high);
     }
@@ -178,7 +180,7 @@ struct CollisionDetector::Impl {
     }
     for (const Found& f : found)
       contacts.push_back({a, b, f.contact.point, f.contact.normal, f.contact.distance, reach_a, reach_b, low_a,
-                          high_a, low_b, high_b, complete});
+                          high_a, low_b, high_b, thinnest, complete});
   }
 };
 

@@ -48,22 +48,26 @@ constexpr int kMaxSubdivision = 8;
 // in a row that needed no more, the next one tries once more at half that depth.
 constexpr int kStepsBeforeCoarser = 4;
 // A step with collisions on is accepted (contacts_move_slowly_enough) when, for every contact, either
-// the pieces can get at most kMaxContactDeepening deeper into each other (contact_deepening_bound), or
-// no point of them travels more than kMaxContactTravel.
+// the pieces can get at most kDeepeningPerHalfWidth times the thinnest one's half-width (and at most
+// kMaxContactTravel) deeper into each other (contact_deepening_bound), or no point of them travels more
+// than kMaxContactTravel.
 //  - kMaxContactTravel (m): a third of the thinnest sheet of the presets (1.5 mm). Measured on the Steel
 //    Fish shaken hard for 600 s: with no such limit, pieces knocked at 2-5 m/s overlapped by up to 4.2 mm
 //    within a step; with 0.5 mm, by less than a micrometre (1 mm still let 1.5 mm through). (Since then,
 //    with the speculative contacts and the split impulse, that test's deepest transient overlap is 0.29 mm.)
-//  - kMaxContactDeepening (m): half the radius of the thinnest wire that can be in contact (the
-//    generated mobiles' threads, 0.5 mm; the presets' are 0.6 mm and up), so that a contact settled
-//    within the penetration slop (0.05 mm) cannot be pushed past a thread's axis, where its normal would
-//    turn round. The bound is sharp where the travel is not (a piece spinning against its neighbour, or
-//    knocked away from it, travels far but goes no deeper), so either test passing accepts the step.
-//    Measured from the benchmarks' swinging state, generated-1023, 5000 steps: halvings 2.83 -> 1.86 per
-//    step; the shaken Steel Fish's deepest transient overlap 0.294 -> 0.263 mm. (The bound alone at
-//    0.5 mm halved 1.14 times per step but let that overlap reach 0.56 mm; alone at 0.25 mm, 2.93 times.)
+//  - kDeepeningPerHalfWidth: a piece's half-width (Contact::thinnest: a wire's radius, half a plate's
+//    thickness) is how deep a neighbour can get before it is nearer the piece's far side, where the
+//    contact normal would turn round and push it through. Half of that per step, on top of an overlap
+//    settled within the penetration slop (0.05 mm) and pushed out by the split impulse, keeps every
+//    overlap below the half-width: 0.25 mm per step against the generated mobiles' 0.5 mm threads,
+//    0.5 mm against their 2 mm plates. The bound is sharp where the travel is not (a piece spinning
+//    against its neighbour, or knocked away from it, travels far but goes no deeper), so either test
+//    passing accepts the step. Measured from the benchmarks' swinging state, generated-1023, 5000 steps:
+//    halvings 2.83 per step with the travel limit alone, 1.86 with a flat 0.25 mm limit on the deepening
+//    too, 1.62 with this one; the shaken Steel Fish's deepest transient overlap 0.294, 0.263 and 0.383 mm
+//    (its threads' radius is 0.6 mm, its plates 0.75-1.25 mm thick on each side).
 constexpr double kMaxContactTravel = 5e-4;
-constexpr double kMaxContactDeepening = 2.5e-4;
+constexpr double kDeepeningPerHalfWidth = 0.5;
 // Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
 // millimetre keeps a resting contact (which settles to within the penetration slop, 0.05 mm) in the
 // list from one step to the next without testing pieces that are far apart.
@@ -306,8 +310,9 @@ double fastest_corner_speed(const Quat& orientation, const Vec3& v, const Vec3& 
 }  // namespace
 
 // With collisions on: whether no component turns more than kOldTurnLimit in a step of h, and for every
-// contact found for this step, either its pieces can get at most kMaxContactDeepening deeper into each
-// other (contact_deepening_bound, at the given velocities; with `after_impulses` false, before the
+// contact found for this step, either its pieces can get at most kDeepeningPerHalfWidth of the thinnest
+// one's half-width deeper into each other (contact_deepening_bound, at the given velocities; with
+// `after_impulses` false, before the
 // contact impulses, the approach is left out: the impulses will stop it), or no point of them travels
 // more than kMaxContactTravel. A contact is a constraint at one point with one normal, from the closest
 // features at the start of the step; a plate edge sweeping several millimetres per step past a 2 mm wire
@@ -368,7 +373,7 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
       return false;
     return contact_deepening_bound(c, side(c.a, c.reach_a, c.near_low_a, c.near_high_a),
                                    side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h,
-                                   after_impulses) <= kMaxContactDeepening;
+                                   after_impulses) <= std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
   };
   for (const Contact& c : work.contacts)
     if (!travels_little(c) && !deepens_little(c)) return false;

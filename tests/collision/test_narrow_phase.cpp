@@ -495,5 +495,19 @@ TEST(NarrowPhase, ThinBoxesCrossingEdgeToEdgeGetTheirExactOverlap) {
   std::printf("thin boxes edge to edge: %d checked, largest error %.3g m\n", checked, worst);
 }
 
+TEST(ConvexPieces, HalfWidthIsHalfTheSmallestWidth) {
+  // What Simulation's limit on how much deeper pieces in contact may get is a fraction of: a sphere's
+  // and a wire's radius, half a plate's thickness, half a box's shortest edge (turned, so that the
+  // smallest width is along no coordinate axis), a short wire's half length. Exact up to rounding.
+  EXPECT_NEAR(pieces_of(Sphere{Vec3(0, 1, 0), 0.012})[0].half_width, 0.012, 1e-15);
+  EXPECT_NEAR(pieces_of(Wire{Vec3(0, 1, 0), Vec3(0.2, 1, 0), 5e-4})[0].half_width, 5e-4, 1e-15);
+  EXPECT_NEAR(pieces_of(Wire{Vec3(0, 1, 0), Vec3(0, 1, 1e-4), 5e-4})[0].half_width, 5e-5, 1e-15);
+  for (const ConvexPiece& part : pieces_of(square_plate(0.03, 0.002))) EXPECT_NEAR(part.half_width, 0.001, 1e-15);
+  Box box;
+  box.size = Vec3(0.03, 0.01, 0.02);
+  box.rotation = Quat(Eigen::AngleAxisd(0.6, Vec3(1, 2, 3).normalized())).toRotationMatrix();
+  EXPECT_NEAR(pieces_of(box)[0].half_width, 0.005, 1e-15);
+}
+
 }  // namespace
 }  // namespace aloft::internal
