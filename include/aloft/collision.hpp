@@ -109,9 +109,10 @@ class CollisionDetector {
   void find_contacts(const State& state, double step, double base_margin, std::vector<Contact>& contacts);
   // Of `found`, what find_contacts(state, step, base_margin) would give, when `found` came from a call
   // at the same pose whose margins were all at least as wide: the contacts below this margin, in the
-  // same order (a pair's deepest are the same whatever the margin). Their reach, near boxes and
-  // `complete` stay those of the wider call (at least as large; false where the narrower look might say
-  // true). Lets a caller whose velocities changed after a wider look skip looking again.
+  // same order (a pair's deepest are the same whatever the margin). Their reach, near boxes, `thinnest`
+  // and `complete` stay those of the wider call (reach and boxes at least as large, `thinnest` at most
+  // as large, `complete` false where the narrower look might say true). Lets a caller whose velocities
+  // changed after a wider look skip looking again.
   void keep_within_margin(const std::vector<Contact>& found, const State& state, double step, double base_margin,
                           std::vector<Contact>& kept) const;
 

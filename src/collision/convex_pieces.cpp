@@ -32,8 +32,6 @@ ConvexPiece polytope(int shape, std::vector<Vec3> vertices) {
   return piece;
 }
 
-// The enclosing sphere of a piece: centre at the middle of its axis-aligned bounds, radius the exact
-// farthest distance from there.
 // Half the piece's smallest width (m; see ConvexPiece::half_width). A polytope's smallest width is
 // across one of its face normals or across the cross product of two of its edge directions; its axes and
 // edges (the faces' normals are crosses of their edges) give them all.
@@ -60,6 +58,8 @@ double smallest_half_width(const ConvexPiece& piece) {
   return 0;
 }
 
+// The enclosing sphere of a piece: centre at the middle of its axis-aligned bounds, radius the exact
+// farthest distance from there.
 Bounds set_bounds(ConvexPiece& piece) {
   Bounds box;
   switch (piece.kind) {
