@@ -309,15 +309,14 @@ double fastest_corner_speed(const Quat& orientation, const Vec3& v, const Vec3& 
 
 }  // namespace
 
-// With collisions on: whether no component turns more than kOldTurnLimit in a step of h, and for every
-// contact found for this step, either its pieces can get at most kDeepeningPerHalfWidth of the thinnest
-// one's half-width deeper into each other (contact_deepening_bound, at the given velocities; with
-// `after_impulses` false, before the
-// contact impulses, the approach is left out: the impulses will stop it), or no point of them travels
-// more than kMaxContactTravel. A contact is a constraint at one point with one normal, from the closest
-// features at the start of the step; a plate edge sweeping several millimetres per step past a 2 mm wire
-// can pierce it away from that point before the next step sees it. Always true for the shortest step
-// the subdivision allows (it must make progress).
+// With collisions on: whether, for every contact found for this step, neither component turns more than
+// kOldTurnLimit in a step of h, and either its pieces can get at most kDeepeningPerHalfWidth of the
+// thinnest one's half-width deeper into each other (contact_deepening_bound, at the given velocities;
+// with `after_impulses` false, before the contact impulses, the approach is left out: the impulses will
+// stop it), or no point of them travels more than kMaxContactTravel. A contact is a constraint at one
+// point with one normal, from the closest features at the start of the step; a plate edge sweeping
+// several millimetres per step past a 2 mm wire can pierce it away from that point before the next step
+// sees it. Always true for the shortest step the subdivision allows (it must make progress).
 bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity,
                                               const std::vector<Vec3>& angular, bool after_impulses) const {
   const StepWorkspace& work = *work_;
@@ -331,9 +330,9 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   // reach), covers its whole sweep, so anything it could reach in the step is a contact of its own.
   // (Until 2026-11-24 the limit held for every component: generated-1023, 5000 steps from the swinging
   // state, 1.62 -> 1.56 halvings per step without it for the components in no contact.)
-  for (const Contact& c : work.contacts)
-    if ((c.a != 0 && h * angular[c.a].norm() > kOldTurnLimit) || h * angular[c.b].norm() > kOldTurnLimit)
-      return false;
+  const auto turns_little = [&](const Contact& c) {
+    return (c.a == 0 || h * angular[c.a].norm() <= kOldTurnLimit) && h * angular[c.b].norm() <= kOldTurnLimit;
+  };
   const std::vector<Mat3>& inertia = work.solver.world_inertia();  // at state_'s pose
   const std::vector<Mat3>& inverse_inertia = work.solver.world_inverse_inertia();
   const auto side = [&](int i, double contact_reach, const Vec3& low, const Vec3& high) {
@@ -376,12 +375,12 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   const auto deepens_little = [&](const Contact& c) {
     if (!c.complete || !(c.near_low_a.x() <= c.near_high_a.x()) || !(c.near_low_b.x() <= c.near_high_b.x()))
       return false;
+    const double allowed = std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
     return contact_deepening_bound(c, side(c.a, c.reach_a, c.near_low_a, c.near_high_a),
-                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h,
-                                   after_impulses) <= std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
+                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, after_impulses) <= allowed;
   };
   for (const Contact& c : work.contacts)
-    if (!travels_little(c) && !deepens_little(c)) return false;
+    if (!turns_little(c) || (!travels_little(c) && !deepens_little(c))) return false;
   return true;
 }
 
