@@ -20,7 +20,7 @@
 // approach at p cannot make convex pieces overlap more than they do (it keeps X on its side of a plane
 // Y is on the other side of), and a turn about the contact normal (a plate spinning flat against a
 // wire) moves nothing towards the plane: neither counts, where a bound on how far any point travels
-// (what this replaced) counted both.
+// (Simulation's travel limit, which a contact may pass instead) counts both.
 //
 // The rest is second order in the turns (theta = h |w| + g, rad), bounded generously (the curvature
 // allowance):
