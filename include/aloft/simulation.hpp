@@ -78,7 +78,13 @@ class Simulation {
   const State& state() const { return state_; }
   // Change the state from outside (reset, a user's drag): the next step re-factors at the new pose.
   State& mutable_state();
-  ExternalLoads& loads() { return loads_; }
+  // The loads applied from outside for the next steps. From the first call on, every step reads them;
+  // a simulation whose loads() was never asked for has none, and its steps skip reading them (two arrays
+  // per step, which the largest mobiles stream from memory).
+  ExternalLoads& loads() {
+    loads_in_use_ = true;
+    return loads_;
+  }
 
   double timestep() const { return timestep_; }
   void set_timestep(double seconds);
@@ -127,11 +133,12 @@ class Simulation {
   bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
   bool at_finest_step(double h) const;
   bool reject_spin(double h);
-  Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
+  Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Mat3& inertia) const;
 
   const Model& model_;
   State state_;
   ExternalLoads loads_;
+  bool loads_in_use_ = false;  // loads() was asked for: the loads may be non-zero
   double timestep_;
   double fixed_joint_tolerance_ = 0;  // m; 0: the default rule
   DampingSpec damping_;

@@ -95,7 +95,6 @@ struct StepWorkspace {
       : solver(model),
         next(rest_state(model)),
         backup(rest_state(model)),
-        wrench(model.count, Vec6::Zero()),
         kick_sum(model.count, Vec6::Zero()),
         rows(model.count, Vec3::Zero()),
         impulse(model.count, Vec3::Zero()),
@@ -119,7 +118,6 @@ struct StepWorkspace {
   State next;                    // the state being computed; swapped in when the step succeeds
   State backup;                  // the state before a subdivided step, to return to if it fails (sized
                                  // here, so that the first halving does not allocate either)
-  std::vector<Vec6> wrench;      // scratch per body (force, torque), world
   std::vector<Vec6> kick_sum;    // the half kick's impulses from the child joints' guesses, summed into each
                                  // parent (N s, N m s, world); zero between kicks (each entry reset once read)
   std::vector<Vec3> rows;        // scratch per joint
@@ -163,7 +161,7 @@ namespace {
 
 // exp(theta / 2) q, renormalised: the orientation q turned by the rotation vector `theta` (rad, world).
 // Written out in scalars (the quaternion product vectorises poorly at this size).
-inline Quat turned(const Vec3& theta, const Quat& q) {
+[[gnu::always_inline]] inline Quat turned(const Vec3& theta, const Quat& q) {
   const double a2 = theta.squaredNorm();
   double c, s;
   if (a2 < 1e-4) {
@@ -251,14 +249,20 @@ void Simulation::set_timestep(double seconds) {
 
 // Applied wrenches at `state` (world): gravity, external loads, air damping. There is no gyroscopic
 // term: the kicks change the world angular momentum L, whose rate is the torque alone; the rotation
-// of the inertia tensor is in the drift (step 2). `momentum` is I w at `state` (for the damping).
-inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& momentum) const {
+// of the inertia tensor is in the drift (step 2). `inertia` is body i's world inertia at `state`: the
+// damping's torque is -angular I w (read only when there is damping: an undamped step does not touch it).
+inline Vec6 Simulation::applied_wrench(const State& state, int i, const Mat3& inertia) const {
   const double m = model_.mass[i];
   Vec6 f;
-  f.head<3>() = m * model_.gravity + loads_.force[i];
-  f.tail<3>() = loads_.torque[i];
+  f.head<3>() = m * model_.gravity;
+  f.tail<3>().setZero();
+  if (loads_in_use_) {
+    f.head<3>() += loads_.force[i];
+    f.tail<3>() = loads_.torque[i];
+  }
   if (damping_.linear != 0 || damping_.angular != 0) {
     f.head<3>() -= damping_.linear * m * state.velocity[i];
+    const Vec3 momentum = inertia * state.angular[i];
     f.tail<3>() -= damping_.angular * momentum;
   }
   return f;
@@ -504,15 +508,18 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   //    tangent: the curvature of the joints' paths) changes slowly. Measured against extrapolating P
   //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.14 -> 0.96 on the Steel Fish,
   //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's
-  //    P scaled to this step's length.
+  //    P scaled to this step's length. Each body's new angular velocity is checked against the step-size
+  //    rule as it is made (spins_ok), while the body's data are at hand.
   const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
   std::vector<Vec6>& sum = work.kick_sum;
+  const StepSizeRule& rule = work.step_rule;
+  bool spins_ok = true;
   for (int i = n - 1; i >= 1; --i) {
     const Vec3 impulse = predict ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
                                  : Vec3(warm * work.impulse[i]);
     work.step_impulse[i] = impulse;
-    Vec6 kick = (0.5 * h) * applied_wrench(now, i, inertia[i] * now.angular[i]) + sum[i];
+    Vec6 kick = (0.5 * h) * applied_wrench(now, i, inertia[i]) + sum[i];
     sum[i].setZero();
     kick.head<3>() += impulse;
     kick.tail<3>() += r[i].cross(impulse);
@@ -523,6 +530,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     }
     next.velocity[i] = now.velocity[i] + kick.head<3>() * (1.0 / model_.mass[i]);
     next.angular[i] = now.angular[i] + inverse_inertia[i] * kick.tail<3>();
+    if (spins_ok) spins_ok = rule.accepts_body(i, h, next.angular[i], inertia[i], inverse_inertia[i], r, s);
   }
 
   // Collisions: impulses on the half-step velocities for the contacts at the current pose, solved with
@@ -532,7 +540,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   if (collisions_) {
     // A step that will be halved as too long for its spins (checked again below, after the impulses) is
     // not worth a detection whose margins its speeds would make huge.
-    if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return reject_spin(h);
+    if (!spins_ok) return reject_spin(h);
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
@@ -591,8 +599,10 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     }
   }
 
-  // The step-size rule on the velocities the drift will use.
-  if (!work.step_rule.accepts(h, next.angular, inertia, inverse_inertia, r, s)) return reject_spin(h);
+  // The step-size rule on the velocities the drift will use (again if contact impulses changed them).
+  if (!work.contacts.empty() && collisions_)
+    spins_ok = rule.accepts(h, next.angular, inertia, inverse_inertia, r, s);
+  if (!spins_ok) return reject_spin(h);
   // The impulses may have knocked a component in contact faster than the check above allowed.
   return !collisions_ || contacts_move_slowly_enough(h, next.velocity, next.angular, true);
 }
@@ -605,7 +615,6 @@ bool Simulation::rattle(double h) {
   const State& now = state_;
   State& next = work.next;
   TreeSolver& solver = work.solver;
-  std::vector<Vec6>& f = work.wrench;
   std::vector<Vec3>& c = work.rows;
   std::vector<Mat3>& rotation = work.rotation;
 
@@ -703,21 +712,25 @@ bool Simulation::rattle(double h) {
   //    angular part of M' v is the angular momentum I w of the half-step velocity (unchanged by the
   //    drift's turn: the free body's). So the tree solve is of the momenta with zero joint rows, and its
   //    result is the new velocity itself.
-  const std::vector<Mat3>& start_inertia = solver.world_inertia();  // still the step's start pose
-  for (int i = 1; i < n; ++i) {
-    const Vec3 momentum = start_inertia[i] * next.angular[i];
-    f[i] = (0.5 * h) * applied_wrench(next, i, momentum);
-    f[i].head<3>() += model_.mass[i] * next.velocity[i];
-    f[i].tail<3>() += momentum;
-  }
+  //    The solver asks for each body's f as its sweep reaches it, with the world inertia of the step's
+  //    start (the pose it factored before), which turns the half-step angular velocity into I w.
+  const auto momenta_and_forces = [&](int i, const Mat3& start_inertia) {
+    const Vec3 momentum = start_inertia * next.angular[i];
+    Vec6 f = (0.5 * h) * applied_wrench(next, i, start_inertia);
+    f.head<3>() += model_.mass[i] * next.velocity[i];
+    f.tail<3>() += momentum;
+    return f;
+  };
   std::swap(work.older_projection, work.projection);
   double sum = 0;
-  solver.factor_and_solve(rotation, work.child_arm, work.parent_arm, f, [&](int i, const Vec6& u, const Vec3& impulse) {
-    next.velocity[i] = u.head<3>();
-    next.angular[i] = u.tail<3>();
-    work.projection[i] = impulse;
-    sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() + next.orientation[i].w();
-  });
+  solver.factor_and_solve(rotation, work.child_arm, work.parent_arm, momenta_and_forces,
+                          [&](int i, const Vec6& u, const Vec3& impulse) {
+                            next.velocity[i] = u.head<3>();
+                            next.angular[i] = u.tail<3>();
+                            work.projection[i] = impulse;
+                            sum += next.position[i].sum() + next.velocity[i].sum() + next.angular[i].sum() +
+                                   next.orientation[i].w();
+                          });
   work.state_sum = sum;
   next.time = now.time + h;
   std::swap(state_, next);

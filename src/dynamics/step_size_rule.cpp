@@ -75,27 +75,31 @@ double StepSizeRule::error_measure(int body, const Vec3& e, const Mat3& inertia)
   return half_trace_[body] > 0 ? std::sqrt(e.dot(inertia * e) / half_trace_[body]) : e.norm();
 }
 
+bool StepSizeRule::slow_checks(int i, double h, double turn2, const Vec3& angular, const Mat3& inertia,
+                               const Mat3& inverse_inertia, const std::vector<Vec3>& child_arm,
+                               const std::vector<Vec3>& parent_arm) const {
+  const double h2 = h * h;
+  constexpr double anchor2 = kMaxAnchorTurn * kMaxAnchorTurn;
+  // No anchor turns more than the body, h |w x a| / |a| <= h |w|: look at them only when the body turns
+  // more than kMaxAnchorTurn. Compared squared and multiplied out: h^2 |w x a|^2 <= turn^2 |a|^2.
+  if (turn2 > anchor2) {
+    if (h2 * angular.cross(child_arm[i]).squaredNorm() > anchor2 * child_arm_squared_[i]) return false;
+    for (int j : children_[i])
+      if (h2 * angular.cross(parent_arm[j]).squaredNorm() > anchor2 * parent_arm_squared_[j]) return false;
+  }
+  if (turn2 > quiet_turn_squared_[i]) {
+    const Vec3 e = drift_error(angular, inertia, inverse_inertia, h);
+    if (!(error_measure(i, e, inertia) <= drift_tolerance_[i])) return false;
+  }
+  return true;
+}
+
 bool StepSizeRule::accepts(double h, const std::vector<Vec3>& angular, const std::vector<Mat3>& inertia,
                            const std::vector<Mat3>& inverse_inertia, const std::vector<Vec3>& child_arm,
                            const std::vector<Vec3>& parent_arm) const {
   const int n = static_cast<int>(angular.size());
-  const double h2 = h * h;
-  constexpr double max_turn2 = kMaxTurn * kMaxTurn, anchor2 = kMaxAnchorTurn * kMaxAnchorTurn;
-  for (int i = 1; i < n; ++i) {
-    const double turn2 = h2 * angular[i].squaredNorm();
-    if (!(turn2 <= max_turn2)) return false;  // also a NaN
-    // No anchor turns more than the body, h |w x a| / |a| <= h |w|: look at them only when the body turns
-    // more than kMaxAnchorTurn. Compared squared and multiplied out: h^2 |w x a|^2 <= turn^2 |a|^2.
-    if (turn2 > anchor2) {
-      if (h2 * angular[i].cross(child_arm[i]).squaredNorm() > anchor2 * child_arm_squared_[i]) return false;
-      for (int j : children_[i])
-        if (h2 * angular[i].cross(parent_arm[j]).squaredNorm() > anchor2 * parent_arm_squared_[j]) return false;
-    }
-    if (turn2 > quiet_turn_squared_[i]) {
-      const Vec3 e = drift_error(angular[i], inertia[i], inverse_inertia[i], h);
-      if (!(error_measure(i, e, inertia[i]) <= drift_tolerance_[i])) return false;
-    }
-  }
+  for (int i = 1; i < n; ++i)
+    if (!accepts_body(i, h, angular[i], inertia[i], inverse_inertia[i], child_arm, parent_arm)) return false;
   return true;
 }
 

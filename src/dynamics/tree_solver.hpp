@@ -33,20 +33,13 @@
 
 
 #include "aloft/state.hpp"
+#include "dynamics/small_matrix.hpp"
 
 namespace aloft {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat63 = Eigen::Matrix<double, 6, 3>;
-
-// R diag(d) R^T (world inertia from principal moments d, or its inverse from 1/d).
-[[gnu::always_inline]] inline Mat3 rotate_diagonal(const Mat3& r, const Vec3& d) {
-  const Mat3 rd = r * d.asDiagonal();
-  Mat3 out;
-  out.noalias() = rd * r.transpose();
-  return out;
-}
 
 // The non-zero part of L^-1 [F; 0] for three wrench columns F applied at one or two bodies, where
 // H = L D L^T is TreeSolver's factorization: only the body and joint nodes on the paths from those bodies
@@ -80,15 +73,20 @@ class TreeSolver {
   // the factorization's, on the blocks just formed, so the step's velocity projection costs one pass
   // over the bodies, not two. (With f_i = M_i u_i + impulse, u' is the velocity that is tangent to the
   // joints at the new pose: what RATTLE's projection needs.)
-  template <class Visit>
+  // The wrenches are asked for as the sweep reaches each body, f_i = wrench(i, I_i), with I_i the body's
+  // world inertia at the pose factored before (the step's start, where the caller's momenta I w are
+  // taken), read just before the sweep overwrites it: no pass of the caller's own over the bodies to
+  // form f, and no array of them (at 65535 components the step streams its arrays from memory, and
+  // every byte per body counts: docs/performance.md).
+  template <class Wrench, class Visit>
   void factor_and_solve(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
-                        std::vector<Vec3>& parent_arm, const std::vector<Vec6>& f, Visit&& visit) {
+                        std::vector<Vec3>& parent_arm, Wrench&& wrench, Visit&& visit) {
     child_arm_.swap(child_arm);
     parent_arm_.swap(parent_arm);
     if (stack_folding_) {
-      factor_blocks<true, true>(rotation, &f);
+      factor_blocks<true, true>(rotation, wrench);
     } else {
-      factor_blocks<true, false>(rotation, &f);
+      factor_blocks<true, false>(rotation, wrench);
     }
     substitute(visit);
   }
@@ -155,9 +153,14 @@ class TreeSolver {
   const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
 
  private:
-  // The factorization's tip-to-base sweep; with kEliminate also eliminate() for the wrenches *f and c = 0.
-  template <bool kEliminate, bool kStack>
-  void factor_blocks(const std::vector<Mat3>& rotation, const std::vector<Vec6>* f);
+  // The factorization's tip-to-base sweep (defined below the class); with kEliminate also eliminate()
+  // for the wrenches wrench(i, previous world inertia) and c = 0.
+  template <bool kEliminate, bool kStack, class Wrench>
+  void factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench);
+  // factor()'s: no wrenches.
+  struct NoWrench {
+    Vec6 operator()(int, const Mat3&) const { return Vec6::Zero(); }
+  };
   // The deepest the folding stack gets for this order of the bodies, or -1 if the order does not allow
   // it (see stack_folding_possible()).
   static int folding_stack_depth(const std::vector<int>& parent);
@@ -233,5 +236,118 @@ class TreeSolver {
 // The symmetric KKT matrix H = [M J^T; J 0] written out densely (moving bodies 1..n-1 as 6-blocks, then
 // joints as 3-blocks), for tests: H [u; -lambda] = [f; c] is the system TreeSolver solves.
 Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
+
+// One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
+// (children have larger indices, so they are done), factored at the joint point (see the header), then
+// joint i eliminated into the parent: A^T K_i^-1 A with A = [E, -[s_i]x] is
+// [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
+// With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
+// With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
+template <bool kEliminate, bool kStack, class Wrench>
+void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench) {
+  const std::vector<int>& parent = model_.parent;
+  int top = 0;  // kStack: folded_[1..top] in use
+  for (int i = n_ - 1; i >= 1; --i) {
+    // kStack: what i's children folded into it, on top of the stack (an interior body's always is).
+    const Folded* mine = kStack && top > 0 && folded_[top].body == i ? &folded_[top] : nullptr;
+    const Mat3 inertia = rotate_diagonal(rotation[i], model_.principal_moments[i]);
+    Vec6 g;  // with kEliminate: the wrench gathered at body i (its own and its child joints')
+    if constexpr (kEliminate) {
+      g = wrench(i, inertia_[i]);  // still the previous pose's inertia
+      if constexpr (kStack) {
+        if (mine) g += mine->g;
+      } else {
+        g += g_[i];
+        g_[i].setZero();
+      }
+    }
+    inertia_[i] = inertia;
+    inverse_inertia_[i] = rotate_diagonal(rotation[i], inverse_moments_[i]);
+    const Vec3& r = child_arm_[i];
+    const double m = model_.mass[i];
+    // D' at the joint point: A = m E + A_f, B' = A [r]x + B_f, C' = I + C_f + B_f^T [r]x - [r]x B'.
+    Mat3 c_inv, p, k_inv;
+    if (leaf_[i]) {
+      // A = m E, B' = m [r]x, C' = I + m [r]x^T [r]x = I + m (|r|^2 E - r r^T) (the parallel-axis theorem),
+      // P = m [r]x C'^-1, K^-1 = m E - P B'^T = m E + m P [r]x.
+      Mat3 c_joint = inertia;
+      c_joint.noalias() -= m * (r * r.transpose());
+      c_joint.diagonal().array() += m * r.squaredNorm();
+      c_inv = symmetric_inverse(c_joint);
+      p = m * skew_times(r, c_inv);
+      k_inv = m * times_skew(p, r);
+      k_inv.diagonal().array() += m;
+    } else {
+      const Mat3* folded_a = &sum_a_[i];
+      const Mat3* folded_b = &sum_b_[i];
+      const Mat3* folded_c = &sum_c_[i];
+      if constexpr (kStack) folded_a = &mine->a, folded_b = &mine->b, folded_c = &mine->c;
+      Mat3 a = *folded_a;
+      a.diagonal().array() += m;
+      const Mat3& b = *folded_b;
+      const Mat3 b_joint = times_skew(a, r) + b;
+      const Mat3 c_joint = (inertia + *folded_c) + times_skew(b.transpose(), r) - skew_times(r, b_joint);
+      c_inv = symmetric_inverse(c_joint);
+      p.noalias() = b_joint * c_inv;
+      k_inv = a;
+      k_inv.noalias() -= p * b_joint.transpose();
+      if constexpr (kStack) {
+        --top;  // mine is done with (its entry may be reused below)
+      } else {
+        sum_a_[i].setZero();
+        sum_b_[i].setZero();
+        sum_c_[i].setZero();
+      }
+    }
+    c_inv_[i] = c_inv;
+    p_[i] = p;
+    k_inv_[i] = k_inv;
+    const int pa = parent[i];
+    Vec3 a;
+    if constexpr (kEliminate) {
+      // c_i = 0: h = g's torque about the joint point, e = C'^-1 h, a = P h - g's force.
+      const Vec3 h = g.tail<3>() - r.cross(g.head<3>());
+      y_[i].head<3>().setZero();
+      y_[i].tail<3>() = c_inv * h;
+      a = p * h - g.head<3>();
+      a_[i] = a;
+    }
+    if (pa != 0) {
+      const Mat3 k_sx = times_skew(k_inv, parent_arm_[i]);
+      if constexpr (kStack) {
+        if (top > 0 && folded_[top].body == pa) {  // a sibling began pa's entry
+          Folded& into = folded_[top];
+          into.a += k_inv;
+          into.b -= k_sx;
+          into.c -= skew_times(parent_arm_[i], k_sx);
+          if constexpr (kEliminate) {
+            into.g.head<3>() -= a;
+            into.g.tail<3>() -= parent_arm_[i].cross(a);
+          }
+        } else {  // the first of pa's children the sweep reaches: 0 - x, as the arrays' sums start at 0
+          Folded& into = folded_[++top];
+          into.body = pa;
+          into.a = k_inv;
+          into.b = -k_sx;
+          into.c = -skew_times(parent_arm_[i], k_sx);
+          if constexpr (kEliminate) {
+            into.g.head<3>() = -a;
+            into.g.tail<3>() = -parent_arm_[i].cross(a);
+          } else {
+            into.g.setZero();
+          }
+        }
+      } else {
+        sum_a_[pa] += k_inv;
+        sum_b_[pa] -= k_sx;
+        sum_c_[pa] -= skew_times(parent_arm_[i], k_sx);
+        if constexpr (kEliminate) {
+          g_[pa].head<3>() -= a;
+          g_[pa].tail<3>() -= parent_arm_[i].cross(a);
+        }
+      }
+    }
+  }
+}
 
 }  // namespace aloft

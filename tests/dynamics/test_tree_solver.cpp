@@ -117,11 +117,20 @@ TEST(TreeSolver, FactorAndSolveMatchesFactorThenSolve) {
 
     TreeSolver fused(model);
     fused.factor(state);  // a first factorization, as the step has one from the step before
-    fused.factor_and_solve(pose.rotation, pose.child_arm, pose.parent_arm, f,
+    // The wrench of each body is asked for once, with the inertia of the pose factored before (here the
+    // same pose, so exactly apart's).
+    std::vector<int> asked(count, 0);
+    const auto wrench = [&](int i, const Mat3& previous_inertia) {
+      ++asked[i];
+      EXPECT_EQ(previous_inertia, apart.world_inertia()[i]) << "body " << i;
+      return f[i];
+    };
+    fused.factor_and_solve(pose.rotation, pose.child_arm, pose.parent_arm, wrench,
                            [&](int i, const Vec6& ui, const Vec3& lam) {
                              fused_u[i] = ui;
                              fused_lambda[i] = lam;
                            });
+    for (int i = 1; i < count; ++i) EXPECT_EQ(asked[i], 1) << "body " << i;
     double scale_u = 0, scale_l = 0, error_u = 0, error_l = 0;
     for (int i = 1; i < count; ++i) {
       scale_u = std::max(scale_u, u[i].norm());
@@ -175,8 +184,9 @@ TEST(TreeSolver, FoldingOnAStackGivesTheSameBitsAsTheArrays) {
     PoseArrays arms = pose;  // factor_and_solve takes the arm arrays over
     std::vector<Vec6>& u = fused[stack];
     u.assign(model.count, Vec6::Zero());
-    solver.factor_and_solve(arms.rotation, arms.child_arm, arms.parent_arm, f,
-                            [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
+    solver.factor_and_solve(
+        arms.rotation, arms.child_arm, arms.parent_arm, [&](int i, const Mat3&) { return f[i]; },
+        [&](int i, const Vec6& ui, const Vec3&) { u[i] = ui; });
     rows[stack].assign(model.count, Vec6::Zero());
     solver.solve(zero, c, rows[stack]);
   }
