@@ -133,7 +133,8 @@ class Simulation {
   bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
   bool at_finest_step(double h) const;
   bool reject_spin(double h);
-  Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Mat3& inertia) const;
+  Eigen::Matrix<double, 6, 1> applied_wrench(const State& state, int i, const Vec3& momentum) const;
+  bool damped() const { return damping_.linear != 0 || damping_.angular != 0; }
 
   const Model& model_;
   State state_;

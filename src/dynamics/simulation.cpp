@@ -249,9 +249,9 @@ void Simulation::set_timestep(double seconds) {
 
 // Applied wrenches at `state` (world): gravity, external loads, air damping. There is no gyroscopic
 // term: the kicks change the world angular momentum L, whose rate is the torque alone; the rotation
-// of the inertia tensor is in the drift (step 2). `inertia` is body i's world inertia at `state`: the
-// damping's torque is -angular I w (read only when there is damping: an undamped step does not touch it).
-inline Vec6 Simulation::applied_wrench(const State& state, int i, const Mat3& inertia) const {
+// of the inertia tensor is in the drift (step 2). `momentum` is body i's I w at `state`, read only for
+// the damping (damped()).
+inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& momentum) const {
   const double m = model_.mass[i];
   Vec6 f;
   f.head<3>() = m * model_.gravity;
@@ -260,9 +260,8 @@ inline Vec6 Simulation::applied_wrench(const State& state, int i, const Mat3& in
     f.head<3>() += loads_.force[i];
     f.tail<3>() = loads_.torque[i];
   }
-  if (damping_.linear != 0 || damping_.angular != 0) {
+  if (damped()) {
     f.head<3>() -= damping_.linear * m * state.velocity[i];
-    const Vec3 momentum = inertia * state.angular[i];
     f.tail<3>() -= damping_.angular * momentum;
   }
   return f;
@@ -455,7 +454,7 @@ double Simulation::correct_and_drift(double h, DriftCorrection correction, bool 
   State& next = work.next;
   double worst = 0;
   ++work.joint_iterations;
-  work.solver.solve_rows_visiting(work.rows, [&](int i, const Vec6& du, const Vec3& impulse) {
+  work.solver.solve_rows_visiting(work.rows, [&](int i, const Vec6& du, const Vec3& impulse) __attribute__((always_inline)) {
     if (correction == DriftCorrection::kVelocity) {
       next.velocity[i] += du.head<3>();
       next.angular[i] += du.tail<3>();
@@ -519,7 +518,8 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     const Vec3 impulse = predict ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
                                  : Vec3(warm * work.impulse[i]);
     work.step_impulse[i] = impulse;
-    Vec6 kick = (0.5 * h) * applied_wrench(now, i, inertia[i]) + sum[i];
+    const Vec3 momentum = damped() ? Vec3(inertia[i] * now.angular[i]) : Vec3::Zero();
+    Vec6 kick = (0.5 * h) * applied_wrench(now, i, momentum) + sum[i];
     sum[i].setZero();
     kick.head<3>() += impulse;
     kick.tail<3>() += r[i].cross(impulse);
@@ -714,9 +714,9 @@ bool Simulation::rattle(double h) {
   //    result is the new velocity itself.
   //    The solver asks for each body's f as its sweep reaches it, with the world inertia of the step's
   //    start (the pose it factored before), which turns the half-step angular velocity into I w.
-  const auto momenta_and_forces = [&](int i, const Mat3& start_inertia) {
+  const auto momenta_and_forces = [&](int i, const Mat3& start_inertia) __attribute__((always_inline)) {
     const Vec3 momentum = start_inertia * next.angular[i];
-    Vec6 f = (0.5 * h) * applied_wrench(next, i, start_inertia);
+    Vec6 f = (0.5 * h) * applied_wrench(next, i, momentum);
     f.head<3>() += model_.mass[i] * next.velocity[i];
     f.tail<3>() += momentum;
     return f;
@@ -724,7 +724,7 @@ bool Simulation::rattle(double h) {
   std::swap(work.older_projection, work.projection);
   double sum = 0;
   solver.factor_and_solve(rotation, work.child_arm, work.parent_arm, momenta_and_forces,
-                          [&](int i, const Vec6& u, const Vec3& impulse) {
+                          [&](int i, const Vec6& u, const Vec3& impulse) __attribute__((always_inline)) {
                             next.velocity[i] = u.head<3>();
                             next.angular[i] = u.tail<3>();
                             work.projection[i] = impulse;
