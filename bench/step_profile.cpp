@@ -1,10 +1,16 @@
 // aloft_step_profile: a fixed, repeatable stepping run for profilers (valgrind --tool=callgrind counts
 // instructions deterministically, so two builds can be compared on a busy machine) and a quick CPU-time
-// figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), then
-// `steps` steps are taken inside timed_steps(), the function to give callgrind's --toggle-collect.
+// figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), or
+// starts from the benchmarks' swinging state (bench_models.hpp, as BM_Step and BM_StepSpan do; one
+// step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
+// the function to give callgrind's --toggle-collect.
 //
-//   aloft_step_profile MOBILE STEPS [collisions 0|1]
+//   aloft_step_profile MOBILE STEPS [collisions 0|1] [breeze|swinging] [joint tolerance, m]
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
+//     joint tolerance: Simulation::set_joint_tolerance for the timed steps (default: the step's rule)
+//
+// The swinging start costs no breeze, so the largest mobiles can be run under callgrind's cache
+// simulation (--cache-sim=yes) in minutes.
 //
 // Prints the thread CPU time per step and per moving component-step, the step halvings and tree solves
 // per step, and a checksum of the final state (equal on two runs of one build).
@@ -20,6 +26,7 @@
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
+#include "bench_models.hpp"
 
 namespace {
 
@@ -40,12 +47,25 @@ __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
 int main(int argc, char** argv) {
   using namespace aloft;
   if (argc < 3) {
-    std::fprintf(stderr, "usage: aloft_step_profile MOBILE(.json or component count) STEPS [collisions 0|1]\n");
+    std::fprintf(stderr,
+                 "usage: aloft_step_profile MOBILE(.json or component count) STEPS [collisions 0|1] "
+                 "[breeze|swinging] [joint tolerance, m]\n");
     return 2;
   }
   const std::string what = argv[1];
   const long steps = std::atol(argv[2]);
   const bool collisions = argc > 3 && std::atoi(argv[3]) != 0;
+  const std::string start_from = argc > 4 ? argv[4] : "breeze";
+  if (start_from != "breeze" && start_from != "swinging") {
+    std::fprintf(stderr, "aloft_step_profile: the start is 'breeze' or 'swinging', not '%s'\n", start_from.c_str());
+    return 2;
+  }
+  const bool swinging = start_from == "swinging";
+  const double joint_tolerance = argc > 5 ? std::atof(argv[5]) : 0.0;
+  if (!(joint_tolerance >= 0)) {
+    std::fprintf(stderr, "aloft_step_profile: the joint tolerance is a length >= 0 (m), not '%s'\n", argv[5]);
+    return 2;
+  }
   try {
     Model model;
     if (what.size() > 5 && what.substr(what.size() - 5) == ".json") {
@@ -56,15 +76,20 @@ int main(int argc, char** argv) {
       g.seed = 1;
       model = compile(parse_mobile_text(generate_mobile(g), "generated-" + what + ".json"));
     }
-    Simulation sim(model);
+    Simulation sim(model, swinging ? bench::swinging_state(model) : rest_state(model));
     sim.set_collisions(collisions);
-    for (int i = 1; i < model.count; ++i) {
-      const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
-      sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
-    }
-    for (int k = 0; k < 300; ++k)
+    if (swinging) {
       if (!sim.step()) throw std::runtime_error(sim.failure()->message);
-    sim.loads().clear();
+    } else {
+      for (int i = 1; i < model.count; ++i) {
+        const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
+        sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+      }
+      for (int k = 0; k < 300; ++k)
+        if (!sim.step()) throw std::runtime_error(sim.failure()->message);
+      sim.loads().clear();
+    }
+    sim.set_joint_tolerance(joint_tolerance);
     const long long halvings = sim.subdivisions(), iterations = sim.joint_iterations();
     const double start = thread_seconds();
     if (!timed_steps(sim, steps)) throw std::runtime_error(sim.failure()->message);

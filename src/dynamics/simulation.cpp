@@ -454,7 +454,7 @@ double Simulation::correct_and_drift(double h, DriftCorrection correction, bool 
   State& next = work.next;
   double worst = 0;
   ++work.joint_iterations;
-  work.solver.solve_rows_visiting(work.rows, [&](int i, const Vec6& du, const Vec3& impulse) __attribute__((always_inline)) {
+  const auto correct_and_drift_body = [&](int i, const Vec6& du, const Vec3& impulse) __attribute__((always_inline)) {
     if (correction == DriftCorrection::kVelocity) {
       next.velocity[i] += du.head<3>();
       next.angular[i] += du.tail<3>();
@@ -463,7 +463,8 @@ double Simulation::correct_and_drift(double h, DriftCorrection correction, bool 
       work.pseudo[i] += du;
     }
     worst = widest(worst, drift_body(model_, work, now, i, h, with_pseudo));
-  });
+  };
+  work.solver.solve_rows_visiting(work.rows, correct_and_drift_body);
   return worst;
 }
 
