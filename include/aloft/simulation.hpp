@@ -79,8 +79,8 @@ class Simulation {
   // Change the state from outside (reset, a user's drag): the next step re-factors at the new pose.
   State& mutable_state();
   // The loads applied from outside for the next steps. From the first call on, every step reads them;
-  // a simulation whose loads() was never asked for has none, and its steps skip reading them (two arrays
-  // per step, which the largest mobiles stream from memory).
+  // a simulation whose loads() was never asked for has none, and its steps skip reading them (two
+  // vectors per component, read twice per step).
   ExternalLoads& loads() {
     loads_in_use_ = true;
     return loads_;

@@ -79,8 +79,8 @@ class StepSizeRule {
 
   // accepts() for body i alone (its angular velocity, world inertia and inverse), for a caller's own pass
   // over the bodies: the step's half kick checks each body as it kicks it, while its data are at hand,
-  // instead of a pass of their own over all of them (at 65535 components the step's passes stream their
-  // arrays from memory). accepts() is true exactly when this is for every moving body.
+  // instead of a pass of the rule's own over all of them. accepts() is true exactly when this is for
+  // every moving body.
   [[gnu::always_inline]] bool accepts_body(int i, double h, const Vec3& angular, const Mat3& inertia,
                                            const Mat3& inverse_inertia, const std::vector<Vec3>& child_arm,
                                            const std::vector<Vec3>& parent_arm) const {

@@ -76,8 +76,7 @@ class TreeSolver {
   // The wrenches are asked for as the sweep reaches each body, f_i = wrench(i, I_i), with I_i the body's
   // world inertia at the pose factored before (the step's start, where the caller's momenta I w are
   // taken), read just before the sweep overwrites it: no pass of the caller's own over the bodies to
-  // form f, and no array of them (at 65535 components the step streams its arrays from memory, and
-  // every byte per body counts: docs/performance.md).
+  // form f, and no array of them (docs/performance.md, "Two passes fewer per step").
   template <class Wrench, class Visit>
   void factor_and_solve(const std::vector<Mat3>& rotation, std::vector<Vec3>& child_arm,
                         std::vector<Vec3>& parent_arm, Wrench&& wrench, Visit&& visit) {
@@ -238,7 +237,8 @@ class TreeSolver {
 Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
-// (children have larger indices, so they are done), factored at the joint point (see the header), then
+// (children have larger indices, so they are done), factored at the joint point (see the top of this
+// file), then
 // joint i eliminated into the parent: A^T K_i^-1 A with A = [E, -[s_i]x] is
 // [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
 // With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
