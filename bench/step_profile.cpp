@@ -22,8 +22,8 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <utility>
 
-#include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "bench_models.hpp"
@@ -71,10 +71,7 @@ int main(int argc, char** argv) {
     if (what.size() > 5 && what.substr(what.size() - 5) == ".json") {
       model = load_mobile(what);
     } else {
-      GenerateOptions g;
-      g.components = std::atoi(what.c_str());
-      g.seed = 1;
-      model = compile(parse_mobile_text(generate_mobile(g), "generated-" + what + ".json"));
+      model = std::move(*bench::generated_model(std::atoi(what.c_str())));  // seed 1
     }
     Simulation sim(model, swinging ? bench::swinging_state(model) : rest_state(model));
     sim.set_collisions(collisions);

@@ -557,7 +557,8 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
     work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
     if (!contacts_move_slowly_enough(h, probe.velocity, probe.angular, false)) return false;
-    if (!work.contacts.empty())
+    const bool resolved = !work.contacts.empty();  // the impulses below change the velocities
+    if (resolved)
       contact_report =
           work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
     // A knock can send a component off faster than its margin assumed: look again with the new
@@ -598,11 +599,12 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
         contact_report.deepest = std::max(contact_report.deepest, again.deepest);
       }
     }
+    // The step-size rule once more, on the velocities the contact impulses made. (The contacts' list may
+    // be empty again by now: a knock can send the pair apart beyond the recheck's margins.)
+    if (resolved) spins_ok = rule.accepts(h, next.angular, inertia, inverse_inertia, r, s);
   }
 
-  // The step-size rule on the velocities the drift will use (again if contact impulses changed them).
-  if (!work.contacts.empty() && collisions_)
-    spins_ok = rule.accepts(h, next.angular, inertia, inverse_inertia, r, s);
+  // The step-size rule on the velocities the drift will use.
   if (!spins_ok) return reject_spin(h);
   // The impulses may have knocked a component in contact faster than the check above allowed.
   return !collisions_ || contacts_move_slowly_enough(h, next.velocity, next.angular, true);
