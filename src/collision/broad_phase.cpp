@@ -1,19 +1,96 @@
-// Sweep and prune over world boxes (see broad_phase.hpp).
+// Overlapping boxes found through the mobile's tree (see broad_phase.hpp).
 
 #include "collision/broad_phase.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <stdexcept>
 
 namespace aloft::internal {
 
-void BroadPhase::reset(std::vector<int> members, int count, int axis, std::vector<int> parent) {
-  order_ = std::move(members);
-  boxes_.assign(count, WorldBox{});
-  axis_ = axis;
-  parent_ = parent.empty() ? std::vector<int>(count, -1) : std::move(parent);
+namespace {
+
+// A box that overlaps nothing, and that merging into anything leaves it unchanged.
+WorldBox empty_box() {
+  const double inf = std::numeric_limits<double>::infinity();
+  return {Vec3::Constant(inf), Vec3::Constant(-inf)};
 }
 
-void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
+// Closed boxes: touching counts as overlapping (as the sweep and prune did).
+inline bool overlap(const WorldBox& a, const WorldBox& b) {
+  return !((a.low.x() > b.high.x()) | (b.low.x() > a.high.x()) | (a.low.y() > b.high.y()) |
+           (b.low.y() > a.high.y()) | (a.low.z() > b.high.z()) | (b.low.z() > a.high.z()));
+}
+
+inline void emit(int a, int b, std::vector<std::pair<int, int>>& overlaps) {
+  overlaps.emplace_back(std::min(a, b), std::max(a, b));
+}
+
+}  // namespace
+
+void BroadPhase::reset(const std::vector<int>& members, int count, int axis, std::vector<int> parent) {
+  count_ = count;
+  axis_ = axis;
+  members_ = members;
+  std::sort(members_.begin(), members_.end());
+  order_ = members_;
+  member_.assign(count, 0);
+  for (int i : members) member_[i] = 1;
+  boxes_.assign(count, empty_box());
+  subtree_.assign(count, empty_box());
+  parent_ = parent.empty() ? std::vector<int>(count, -1) : std::move(parent);
+  for (int i = 0; i < count; ++i)
+    if (parent_[i] >= i) throw std::invalid_argument("BroadPhase: a component's parent must come before it");
+  // Children in compressed rows; roots apart.
+  child_begin_.assign(count + 1, 0);
+  roots_.clear();
+  for (int i = 0; i < count; ++i) {
+    if (parent_[i] >= 0) ++child_begin_[parent_[i] + 1];
+    else roots_.push_back(i);
+  }
+  for (int i = 0; i < count; ++i) child_begin_[i + 1] += child_begin_[i];
+  child_.assign(child_begin_[count], 0);
+  std::vector<int> next(child_begin_.begin(), child_begin_.end() - 1);
+  for (int i = 0; i < count; ++i)
+    if (parent_[i] >= 0) child_[next[parent_[i]]++] = i;
+  // Subtree sizes, tips first (parent[i] < i).
+  size_.assign(count, 1);
+  for (int i = count - 1; i >= 0; --i)
+    if (parent_[i] >= 0) size_[parent_[i]] += size_[i];
+}
+
+void BroadPhase::query(int a, const WorldBox& box, int root, std::vector<std::pair<int, int>>& overlaps) {
+  if (!overlap(box, subtree_[root])) return;
+  query_stack_.clear();
+  query_stack_.push_back(root);
+  while (!query_stack_.empty()) {
+    const int x = query_stack_.back();  // its subtree box overlaps `box`
+    query_stack_.pop_back();
+    if (member_[x] && parent_[x] != a && overlap(box, boxes_[x])) emit(a, x, overlaps);
+    for (int k = child_begin_[x]; k < child_begin_[x + 1]; ++k)
+      if (overlap(box, subtree_[child_[k]])) query_stack_.push_back(child_[k]);
+  }
+}
+
+void BroadPhase::collide(int x, int y, std::vector<std::pair<int, int>>& overlaps) {
+  // Split the larger of the two subtrees into its root's own box and its children's subtrees; every pair
+  // with one member in each subtree is met exactly once.
+  if (!overlap(subtree_[x], subtree_[y])) return;
+  pair_stack_.clear();
+  pair_stack_.emplace_back(x, y);
+  while (!pair_stack_.empty()) {
+    auto [p, q] = pair_stack_.back();  // their subtree boxes overlap
+    pair_stack_.pop_back();
+    if (size_[p] < size_[q]) std::swap(p, q);
+    for (int k = child_begin_[p]; k < child_begin_[p + 1]; ++k)
+      if (overlap(subtree_[child_[k]], subtree_[q])) pair_stack_.emplace_back(child_[k], q);
+    // (query() uses its own stack; the pairs pushed above wait.) p and q's subtree are unrelated: the
+    // joined test in query() never applies.
+    if (member_[p]) query(p, boxes_[p], q, overlaps);
+  }
+}
+
+void BroadPhase::sweep_and_prune(std::vector<std::pair<int, int>>& overlaps) {
   // Insertion sort by (low end, index): ties broken by index, so the order is deterministic.
   auto before = [&](int x, int y) {
     const double lx = boxes_[x].low[axis_], ly = boxes_[y].low[axis_];
@@ -35,7 +112,6 @@ void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
     const WorldBox& b = boxes_[order_[k]];
     sorted_[k] = {{b.low[axis_], b.low[u], b.low[w]}, {b.high[axis_], b.high[u], b.high[w]}, order_[k]};
   }
-  overlaps.clear();
   const SortedBox* box = sorted_.data();     // (not re-read through the vector after each emplace_back,
   const std::size_t count = sorted_.size();  // which may alias it)
   for (std::size_t k = 0; k < count; ++k) {
@@ -51,6 +127,35 @@ void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
       overlaps.emplace_back(low, high);
     }
   }
+  std::sort(overlaps.begin(), overlaps.end());
+}
+
+void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
+  overlaps.clear();
+  if (members_.size() < kTreeMembers) {
+    sweep_and_prune(overlaps);
+    return;
+  }
+  // Subtree boxes, tips first: each component's own box, grown by its children's subtree boxes.
+  for (int i = 0; i < count_; ++i) subtree_[i] = boxes_[i];
+  for (int i = count_ - 1; i >= 0; --i) {
+    const int p = parent_[i];
+    if (p < 0) continue;
+    subtree_[p].low = subtree_[p].low.cwiseMin(subtree_[i].low);
+    subtree_[p].high = subtree_[p].high.cwiseMax(subtree_[i].high);
+  }
+  // Each pair under its lowest common ancestor p: p's own box against each child's subtree (p's own
+  // children left out: joined), and every two children's subtrees against each other. The roots are
+  // children of a common ancestor above them all.
+  for (int p = 0; p < count_; ++p) {
+    const int begin = child_begin_[p], end = child_begin_[p + 1];
+    for (int k = begin; k < end; ++k) {
+      if (member_[p]) query(p, boxes_[p], child_[k], overlaps);
+      for (int l = k + 1; l < end; ++l) collide(child_[k], child_[l], overlaps);
+    }
+  }
+  for (std::size_t k = 0; k < roots_.size(); ++k)
+    for (std::size_t l = k + 1; l < roots_.size(); ++l) collide(roots_[k], roots_[l], overlaps);
   std::sort(overlaps.begin(), overlaps.end());
 }
 

@@ -1,10 +1,24 @@
 #pragma once
-// Broad phase: sweep and prune over world axis-aligned boxes, one per component.
+// Broad phase: which components' world axis-aligned boxes overlap, one box per component.
+//
+// Two ways, the same pairs (BroadPhase.FindsExactlyThePairsThatATestOfEveryPairFinds):
+//  - from kTreeMembers members on, through the mobile's own tree. A mobile's subtrees are compact in
+//    space (whatever hangs below a bar stays within reach of it) and two sibling subtrees mostly hang
+//    apart. So every component's subtree gets the box around its own box and its children's subtree
+//    boxes (one pass, tips first), and the pairs are found by descending two subtrees only while their
+//    boxes overlap: each pair of components is met under their lowest common ancestor, as the
+//    ancestor's own box against the subtree holding the other, or as two sibling subtrees against each
+//    other.
+//  - below that, sweep and prune along one axis (the members kept sorted by the low end of their box
+//    with an insertion sort, O(n) when the order barely changes between calls). It pays for every pair
+//    of boxes that overlap along that axis: on a deep mobile, long bars overlap hundreds of others along
+//    any axis, and at 8191 components it was the largest single cost of the collisions-on step (17-20 %).
+//    On small mobiles it is the cheaper of the two (callgrind, collisions-on steps of generated mobiles:
+//    the tree +3.6 % instructions at 127 components, +2.3 % at 255, -0.3 % at 511; docs/performance.md,
+//    "The broad phase through the mobile's tree").
 //
 // The boxes are set by the caller each call (box_of() turns a body-frame box and a pose into a world box
-// grown by a margin). The members are kept sorted by the low end of their box along `axis` with an
-// insertion sort, which is O(n) when the order barely changes between calls (a mobile moves little per
-// step); sweeping then yields the pairs whose boxes overlap on all three axes, sorted by (a, b).
+// grown by a margin). Nothing allocates once the scratch has grown.
 
 #include <utility>
 #include <vector>
@@ -26,25 +40,49 @@ inline WorldBox box_of(const Pose& pose, const Vec3& center, const Vec3& half, d
 
 class BroadPhase {
  public:
-  // `members`: the components that take part (indices < count); `axis`: 0, 1 or 2; `parent`: each
-  // component's parent (indices < count; empty: none are left out as joined).
-  void reset(std::vector<int> members, int count, int axis, std::vector<int> parent = {});
+  // `members`: the components that take part (indices < count); `axis`: the sweep's axis (0, 1 or 2;
+  // widest_axis() of the rest pose is best); `parent`: each component's parent (-1 for the fixed
+  // component; parent[i] < i, as compile() orders them). A parent and its child are left out (joined).
+  // Empty `parent`: no tree and no pair left out (from kTreeMembers members on, every pair of members
+  // is then looked at).
+  void reset(const std::vector<int>& members, int count, int axis, std::vector<int> parent = {});
+  // A member's world box, to be set before each sweep() (non-members' boxes are empty and stay so).
   WorldBox& box(int component) { return boxes_[component]; }
-  // Pairs (a, b), a < b, of members whose boxes overlap, sorted, except a parent and its child (their
-  // boxes always overlap, and the joint is not a contact: on a generated mobile, nearly all the
-  // overlaps). Replaces `overlaps`.
+  // Pairs (a, b), a < b, of members whose boxes overlap (closed boxes: touching counts), sorted, except a
+  // parent and its child (their boxes always overlap, and the joint is not a contact: on a generated
+  // mobile, nearly all the overlaps). Replaces `overlaps`.
   void sweep(std::vector<std::pair<int, int>>& overlaps);
 
  private:
+  // Every member of the subtree at `root` whose box overlaps `box`, paired with `a` (except root itself
+  // when it is a's child: joined).
+  void query(int a, const WorldBox& box, int root, std::vector<std::pair<int, int>>& overlaps);
+  // Every pair of members, one in each of two disjoint subtrees, whose boxes overlap.
+  void collide(int x, int y, std::vector<std::pair<int, int>>& overlaps);
+
+  // From this many members on, the tree (see the top of this file).
+  static constexpr std::size_t kTreeMembers = 512;
+  void sweep_and_prune(std::vector<std::pair<int, int>>& overlaps);
+
+  int count_ = 0;
   int axis_ = 0;
-  std::vector<int> order_;       // members, sorted by low end along axis_ (kept between calls)
-  std::vector<WorldBox> boxes_;  // by component
-  std::vector<int> parent_;      // by component (-1: none given)
+  std::vector<int> members_;           // sorted
+  std::vector<int> order_;             // sweep and prune: members sorted by low end along axis_ (kept)
   struct SortedBox {
     double low[3], high[3];  // world, m, axes permuted: the sweep axis, then the next two (cyclically)
     int component;
   };
-  std::vector<SortedBox> sorted_;  // sweep scratch: the members' boxes in order_ (sized once)
+  std::vector<SortedBox> sorted_;      // sweep and prune scratch: the members' boxes in order_
+  std::vector<char> member_;           // by component
+  std::vector<WorldBox> boxes_;        // by component: its own box (empty for non-members)
+  std::vector<WorldBox> subtree_;      // sweep scratch: the box around a component's subtree's boxes
+  std::vector<int> parent_;            // by component (-1: a root)
+  std::vector<int> child_begin_;       // children of i: child_[child_begin_[i] .. child_begin_[i + 1])
+  std::vector<int> child_;
+  std::vector<int> roots_;             // components without a parent
+  std::vector<int> size_;              // components in each subtree (members or not)
+  std::vector<int> query_stack_;       // scratch
+  std::vector<std::pair<int, int>> pair_stack_;  // scratch
 };
 
 // The world axis (0, 1, 2) along which the points spread most: the best sweep axis.

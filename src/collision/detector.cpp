@@ -5,9 +5,9 @@
 // by its own speculative margin
 //     m_i = base_margin / 2 + step * (|v_i| + |w_i| * reach_i),
 // so a pair's boxes overlap whenever its shapes could be closer than m_a + m_b (the contract's margin).
-// Sweep and prune (broad_phase.hpp) over the components that have shapes gives the overlapping pairs;
-// PairFilter drops the joined ones and those the reach test proves never touch, a binary search the
-// pairs touching at rest.
+// The broad phase (broad_phase.hpp: sweep and prune, or the boxes through the mobile's tree from 512
+// components on) over the components that have shapes gives the overlapping pairs; PairFilter drops the
+// joined ones and those the reach test proves never touch, a binary search the pairs touching at rest.
 //
 // Narrow phase. For each pair (in increasing (a, b)), each pair of pieces whose enclosing spheres come
 // within the margin goes to piece_contact(); a pair keeps at most kMaxContactsPerPair contacts, the
@@ -193,7 +193,7 @@ CollisionDetector::CollisionDetector(const Model& model)
     d.members.push_back(i);
     rest_points.push_back(model.rest_position[i]);
   }
-  // Sweep along the world axis the rest pose spreads most along.
+  // (Sweep and prune, for small mobiles: along the world axis the rest pose spreads most along.)
   d.broad.reset(d.members, model.count, internal::widest_axis(rest_points), model.parent);
   d.pose.resize(model.count);
   d.margin.assign(model.count, 0);

@@ -149,7 +149,7 @@ CollisionPairs prune_pairs(const Model& model, const std::vector<ComponentGeomet
     rest_points.push_back(model.rest_position[i]);
   }
   BroadPhase broad;
-  broad.reset(members, n, widest_axis(rest_points));
+  broad.reset(members, n, widest_axis(rest_points), model.parent);  // (joined pairs left out here too)
   for (int i : members)
     broad.box(i) = box_of(rest_pose(model, i), geometry[i].box_center, geometry[i].box_half,
                           0.5 * kRestTouchDistance);

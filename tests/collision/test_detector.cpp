@@ -207,5 +207,54 @@ TEST(BroadPhase, LeavesOutAParentAndItsChildButNotSiblings) {
   EXPECT_EQ(overlaps_of({}), (std::vector<std::pair<int, int>>{{1, 2}, {1, 3}, {2, 3}}));
 }
 
+TEST(BroadPhase, FindsExactlyThePairsThatATestOfEveryPairFinds) {
+  // Random trees (parent[i] < i, as compiled mobiles order them), chains up to 2000 deep, and stars;
+  // random boxes, some components without one (not members), coordinates on a coarse grid so that many
+  // boxes touch exactly (closed boxes: touching counts), a random sweep axis. Both ways (sweep and prune
+  // below 512 members, the tree's subtree boxes from 512 on) only prune: the pairs must be those of the
+  // all-pairs test, parent-child pairs left out.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> grid(0, 40);
+  std::uniform_int_distribution<int> extent(0, 8);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int trees = 0;
+  long long pairs_seen = 0;
+  for (const int count : {1, 2, 3, 17, 100, 600, 700, 2000}) {  // (about 80 % members: the tree from 700 on)
+    for (const int shape : {0, 1, 2}) {  // random tree, chain, star
+      std::vector<int> parent(count, -1);
+      for (int i = 1; i < count; ++i)
+        parent[i] = shape == 0 ? static_cast<int>(unit(rng) * i) : shape == 1 ? i - 1 : 0;
+      std::vector<int> members;
+      for (int i = 0; i < count; ++i)
+        if (unit(rng) < 0.8) members.push_back(i);
+      internal::BroadPhase broad;
+      broad.reset(members, count, static_cast<int>(unit(rng) * 3), parent);
+      std::vector<internal::WorldBox> boxes(count);
+      for (const int i : members) {
+        const Vec3 low(0.025 * grid(rng), 0.025 * grid(rng), 0.025 * grid(rng));
+        const Vec3 size(0.025 * extent(rng), 0.025 * extent(rng), 0.025 * extent(rng));
+        boxes[i] = {low, low + size};
+        broad.box(i) = boxes[i];
+      }
+      std::vector<std::pair<int, int>> found, expected;
+      broad.sweep(found);
+      for (std::size_t x = 0; x < members.size(); ++x) {
+        for (std::size_t y = x + 1; y < members.size(); ++y) {
+          const int a = members[x], b = members[y];  // a < b
+          if (parent[b] == a) continue;
+          const internal::WorldBox &p = boxes[a], &q = boxes[b];
+          if ((p.low.array() <= q.high.array()).all() && (q.low.array() <= p.high.array()).all())
+            expected.emplace_back(a, b);
+        }
+      }
+      ASSERT_EQ(found, expected) << count << " components, shape " << shape;
+      ++trees;
+      pairs_seen += static_cast<long long>(expected.size());
+    }
+  }
+  std::printf("%d trees, %lld overlapping pairs, all found\n", trees, pairs_seen);
+  EXPECT_GT(pairs_seen, 10000);  // the boxes are dense enough for the comparison to mean something
+}
+
 }  // namespace
 }  // namespace aloft
