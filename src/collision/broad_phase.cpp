@@ -1,4 +1,4 @@
-// Overlapping boxes found through the mobile's tree (see broad_phase.hpp).
+// Overlapping boxes: sweep and prune, or through the mobile's tree (see broad_phase.hpp).
 
 #include "collision/broad_phase.hpp"
 
