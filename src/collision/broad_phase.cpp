@@ -48,6 +48,8 @@ void BroadPhase::reset(const std::vector<int>& members, int count, int axis, std
     if (parent_[i] >= 0) ++child_begin_[parent_[i] + 1];
     else roots_.push_back(i);
   }
+  most_children_ = 0;
+  for (int i = 0; i < count; ++i) most_children_ = std::max(most_children_, child_begin_[i + 1]);
   for (int i = 0; i < count; ++i) child_begin_[i + 1] += child_begin_[i];
   child_.assign(child_begin_[count], 0);
   std::vector<int> next(child_begin_.begin(), child_begin_.end() - 1);
@@ -132,7 +134,8 @@ void BroadPhase::sweep_and_prune(std::vector<std::pair<int, int>>& overlaps) {
 
 void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
   overlaps.clear();
-  if (members_.size() < kTreeMembers) {
+  if (members_.size() < kTreeMembers || most_children_ > kTreeMostChildren ||
+      roots_.size() > static_cast<std::size_t>(kTreeMostChildren)) {
     sweep_and_prune(overlaps);
     return;
   }

@@ -2,7 +2,8 @@
 // Broad phase: which components' world axis-aligned boxes overlap, one box per component.
 //
 // Two ways, the same pairs (BroadPhase.FindsExactlyThePairsThatATestOfEveryPairFinds):
-//  - from kTreeMembers members on, through the mobile's own tree. A mobile's subtrees are compact in
+//  - from kTreeMembers members on (on trees no wider than kTreeMostChildren), through the mobile's own
+//    tree. A mobile's subtrees are compact in
 //    space (whatever hangs below a bar stays within reach of it) and two sibling subtrees mostly hang
 //    apart. So every component's subtree gets the box around its own box and its children's subtree
 //    boxes (one pass, tips first), and the pairs are found by descending two subtrees only while their
@@ -43,8 +44,7 @@ class BroadPhase {
   // `members`: the components that take part (indices < count); `axis`: the sweep's axis (0, 1 or 2;
   // widest_axis() of the rest pose is best); `parent`: each component's parent (-1 for the fixed
   // component; parent[i] < i, as compile() orders them). A parent and its child are left out (joined).
-  // Empty `parent`: no tree and no pair left out (from kTreeMembers members on, every pair of members
-  // is then looked at).
+  // Empty `parent`: no tree (sweep and prune, as every component is then a root) and no pair left out.
   void reset(const std::vector<int>& members, int count, int axis, std::vector<int> parent = {});
   // A member's world box, to be set before each sweep() (non-members' boxes are empty and stay so).
   WorldBox& box(int component) { return boxes_[component]; }
@@ -60,8 +60,12 @@ class BroadPhase {
   // Every pair of members, one in each of two disjoint subtrees, whose boxes overlap.
   void collide(int x, int y, std::vector<std::pair<int, int>>& overlaps);
 
-  // From this many members on, the tree (see the top of this file).
+  // From this many members on, the tree (see the top of this file), unless a component has more than
+  // kTreeMostChildren children, or there are more roots: the tree meets every two children's subtrees of
+  // a component, so many components hung from one bar (a flat mobile) would cost the square of their
+  // number per call, where sweep and prune sorts them along its axis.
   static constexpr std::size_t kTreeMembers = 512;
+  static constexpr int kTreeMostChildren = 16;
   void sweep_and_prune(std::vector<std::pair<int, int>>& overlaps);
 
   int count_ = 0;
@@ -81,6 +85,7 @@ class BroadPhase {
   std::vector<int> child_;
   std::vector<int> roots_;             // components without a parent
   std::vector<int> size_;              // components in each subtree (members or not)
+  int most_children_ = 0;              // the most children any component has
   std::vector<int> query_stack_;       // scratch
   std::vector<std::pair<int, int>> pair_stack_;  // scratch
 };

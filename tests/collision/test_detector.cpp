@@ -211,8 +211,8 @@ TEST(BroadPhase, FindsExactlyThePairsThatATestOfEveryPairFinds) {
   // Random trees (parent[i] < i, as compiled mobiles order them), chains up to 2000 deep, and stars;
   // random boxes, some components without one (not members), coordinates on a coarse grid so that many
   // boxes touch exactly (closed boxes: touching counts), a random sweep axis. Both ways (sweep and prune
-  // below 512 members, the tree's subtree boxes from 512 on) only prune: the pairs must be those of the
-  // all-pairs test, parent-child pairs left out.
+  // below 512 members and for the stars, the tree's subtree boxes from 512 on) only prune: the pairs must
+  // be those of the all-pairs test, parent-child pairs left out.
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> grid(0, 40);
   std::uniform_int_distribution<int> extent(0, 8);
