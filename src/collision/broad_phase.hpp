@@ -3,13 +3,12 @@
 //
 // Two ways, the same pairs (BroadPhase.FindsExactlyThePairsThatATestOfEveryPairFinds):
 //  - from kTreeMembers members on (on trees no wider than kTreeMostChildren), through the mobile's own
-//    tree. A mobile's subtrees are compact in
-//    space (whatever hangs below a bar stays within reach of it) and two sibling subtrees mostly hang
-//    apart. So every component's subtree gets the box around its own box and its children's subtree
-//    boxes (one pass, tips first), and the pairs are found by descending two subtrees only while their
-//    boxes overlap: each pair of components is met under their lowest common ancestor, as the
-//    ancestor's own box against the subtree holding the other, or as two sibling subtrees against each
-//    other.
+//    tree. A mobile's subtrees are compact in space (whatever hangs below a bar stays within reach of
+//    it) and two sibling subtrees mostly hang apart. So every component's subtree gets the box around
+//    its own box and its children's subtree boxes (one pass, tips first), and the pairs are found by
+//    descending two subtrees only while their boxes overlap: each pair of components is met under their
+//    lowest common ancestor, as the ancestor's own box against the subtree holding the other, or as two
+//    sibling subtrees against each other.
 //  - below that, sweep and prune along one axis (the members kept sorted by the low end of their box
 //    with an insertion sort, O(n) when the order barely changes between calls). It pays for every pair
 //    of boxes that overlap along that axis: on a deep mobile, long bars overlap hundreds of others along
