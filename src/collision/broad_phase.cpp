@@ -31,9 +31,7 @@ inline void emit(int a, int b, std::vector<std::pair<int, int>>& overlaps) {
 void BroadPhase::reset(const std::vector<int>& members, int count, int axis, std::vector<int> parent) {
   count_ = count;
   axis_ = axis;
-  members_ = members;
-  std::sort(members_.begin(), members_.end());
-  order_ = members_;
+  order_ = members;  // (sorted along axis_ by the first sweep_and_prune)
   member_.assign(count, 0);
   for (int i : members) member_[i] = 1;
   boxes_.assign(count, empty_box());
@@ -134,7 +132,7 @@ void BroadPhase::sweep_and_prune(std::vector<std::pair<int, int>>& overlaps) {
 
 void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
   overlaps.clear();
-  if (members_.size() < kTreeMembers || most_children_ > kTreeMostChildren ||
+  if (order_.size() < kTreeMembers || most_children_ > kTreeMostChildren ||
       roots_.size() > static_cast<std::size_t>(kTreeMostChildren)) {
     sweep_and_prune(overlaps);
     return;

@@ -69,8 +69,8 @@ class BroadPhase {
 
   int count_ = 0;
   int axis_ = 0;
-  std::vector<int> members_;           // sorted
-  std::vector<int> order_;             // sweep and prune: members sorted by low end along axis_ (kept)
+  std::vector<int> order_;             // the members; sweep and prune keeps them sorted by low end along
+                                       // axis_ between calls
   struct SortedBox {
     double low[3], high[3];  // world, m, axes permuted: the sweep axis, then the next two (cyclically)
     int component;
