@@ -238,8 +238,7 @@ Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
 
 // One tip-to-base sweep: body i's own inertia, then D_i from what its children's joints folded in
 // (children have larger indices, so they are done), factored at the joint point (see the top of this
-// file), then
-// joint i eliminated into the parent: A^T K_i^-1 A with A = [E, -[s_i]x] is
+// file), then joint i eliminated into the parent: A^T K_i^-1 A with A = [E, -[s_i]x] is
 // [K^-1, -K^-1 [s]x; [s]x K^-1, -[s]x K^-1 [s]x] (K^-1 symmetric).
 // With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
 // With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
