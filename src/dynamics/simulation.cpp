@@ -507,17 +507,25 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   //    their difference (what closing the joints at the end of a drift needs beyond making the velocities
   //    tangent: the curvature of the joints' paths) changes slowly. Measured against extrapolating P
   //    (2 P_n - P_n-1), which it replaced: Newton corrections per step 1.14 -> 0.96 on the Steel Fish,
-  //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). Otherwise the last step's
-  //    P scaled to this step's length. Each body's new angular velocity is checked against the step-size
-  //    rule as it is made (spins_ok), while the body's data are at hand.
+  //    3.00 -> 2.02 on generated-1023 after the breeze (docs/performance.md). When only the last step had
+  //    this length (the second step of a run, or the second after the step length changed), P = M_n:
+  //    the same guess without the difference, which needs two steps. (Until 2026-11-25 it was P_n, the
+  //    last first-kick impulse, which acted at the last pose; after the first step of a run, which has no
+  //    guess, that gap was 3400 times the tolerance on generated-65535 and took 3 corrections, against 1
+  //    with M_n, and the corrections' impulses stay in the difference term of the steps after:
+  //    generated-127, 1000 steps from the swinging state, 1.19 -> 1.12 tree solves per step.)
+  //    Otherwise the last step's P scaled to this step's length. Each body's new angular velocity is
+  //    checked against the step-size rule as it is made (spins_ok), while the body's data are at hand.
   const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
+  const bool project = guess && !predict && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
   std::vector<Vec6>& sum = work.kick_sum;
   const StepSizeRule& rule = work.step_rule;
   bool spins_ok = true;
   for (int i = n - 1; i >= 1; --i) {
-    const Vec3 impulse = predict ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
-                                 : Vec3(warm * work.impulse[i]);
+    const Vec3 impulse = predict   ? Vec3(work.projection[i] + (work.impulse[i] - work.older_projection[i]))
+                         : project ? work.projection[i]
+                                   : Vec3(warm * work.impulse[i]);
     work.step_impulse[i] = impulse;
     const Vec3 momentum = damped() ? Vec3(inertia[i] * now.angular[i]) : Vec3::Zero();
     Vec6 kick = (0.5 * h) * applied_wrench(now, i, momentum) + sum[i];

@@ -170,9 +170,24 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
     }
     sim.loads().clear();
     const double kinetic = kinetic_energy(model, sim.state());
-    const double start = kinetic + potential_energy(model, sim.state());
-    ASSERT_TRUE(sim.advance(1.0)) << sim.failure()->message;
-    const double end = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+    // Growth, not the integrator's oscillation: the energy of a single step differs from the one the
+    // symplectic step conserves by O((h w)^2) of the kinetic energy, w the fastest spin, and oscillates
+    // about it without a trend. With arms spun at tens of rad/s that reached 1.85 times the allowance
+    // below within a second with no contact at all (seed 7, cycle 59, after the joint-impulse guess of
+    // 2026-11-25), so a comparison of the first and last step's energies failed on 1 of 13 seeds of this
+    // shaking both before and after that change (docs/performance.md, "2026-11-25: the guess"). Compared
+    // instead: the mean energy over the first and the last quarter of the second (worst over 13 seeds:
+    // 0.60 of the allowance before the change, 0.37 after). A gain from contacts (a bounce, the overlap
+    // push) stays in the energy and shows in the later mean.
+    const int steps = static_cast<int>(std::lround(1.0 / sim.timestep()));
+    const int window = steps / 4;
+    double start = 0, end = 0;  // mean energies over the first and the last window (J)
+    for (int step = 0; step < steps; ++step) {
+      ASSERT_TRUE(sim.step()) << sim.failure()->message;
+      const double energy = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+      if (step < window) start += energy / window;
+      if (step >= steps - window) end += energy / window;
+    }
     // Allowed: the integrator's error (1e-4 of the kinetic energy; the conservation test measures far
     // less without contacts) and the lift of the overlap correction, which may raise a piece by its
     // overlap (< 0.1 mm) against gravity.
