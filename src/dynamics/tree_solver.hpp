@@ -274,7 +274,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench
       c_joint.diagonal().array() += m * r.squaredNorm();
       c_inv = symmetric_inverse(c_joint);
       p = m * skew_times(r, c_inv);
-      k_inv = m * times_skew(p, r);
+      k_inv = m * times_skew_symmetric(p, r);
       k_inv.diagonal().array() += m;
     } else {
       const Mat3* folded_a = &sum_a_[i];
@@ -288,8 +288,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench
       const Mat3 c_joint = (inertia + *folded_c) + times_skew(b.transpose(), r) - skew_times(r, b_joint);
       c_inv = symmetric_inverse(c_joint);
       p.noalias() = b_joint * c_inv;
-      k_inv = a;
-      k_inv.noalias() -= p * b_joint.transpose();
+      k_inv = minus_symmetric_product(a, p, b_joint);
       if constexpr (kStack) {
         --top;  // mine is done with (its entry may be reused below)
       } else {
@@ -318,7 +317,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench
           Folded& into = folded_[top];
           into.a += k_inv;
           into.b -= k_sx;
-          into.c -= skew_times(parent_arm_[i], k_sx);
+          into.c -= skew_times_symmetric(parent_arm_[i], k_sx);
           if constexpr (kEliminate) {
             into.g.head<3>() -= a;
             into.g.tail<3>() -= parent_arm_[i].cross(a);
@@ -328,7 +327,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench
           into.body = pa;
           into.a = k_inv;
           into.b = -k_sx;
-          into.c = -skew_times(parent_arm_[i], k_sx);
+          into.c = -skew_times_symmetric(parent_arm_[i], k_sx);
           if constexpr (kEliminate) {
             into.g.head<3>() = -a;
             into.g.tail<3>() = -parent_arm_[i].cross(a);
@@ -339,7 +338,7 @@ void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench
       } else {
         sum_a_[pa] += k_inv;
         sum_b_[pa] -= k_sx;
-        sum_c_[pa] -= skew_times(parent_arm_[i], k_sx);
+        sum_c_[pa] -= skew_times_symmetric(parent_arm_[i], k_sx);
         if constexpr (kEliminate) {
           g_[pa].head<3>() -= a;
           g_[pa].tail<3>() -= parent_arm_[i].cross(a);
