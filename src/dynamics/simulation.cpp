@@ -511,7 +511,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
   //    this length (the second step of a run, or the second after the step length changed), P = M_n:
   //    the same guess without the difference, which needs two steps. (Until 2026-11-25 it was P_n, the
   //    last first-kick impulse, which acted at the last pose; after the first step of a run, which has no
-  //    guess, that gap was 3400 times the tolerance on generated-65535 and took 3 corrections, against 1
+  //    guess, that gap was 3380 times the tolerance on generated-65535 and took 3 corrections, against 1
   //    with M_n, and the corrections' impulses stay in the difference term of the steps after:
   //    generated-127, 1000 steps from the swinging state, 1.19 -> 1.12 tree solves per step.)
   //    Otherwise the last step's P scaled to this step's length. Each body's new angular velocity is
