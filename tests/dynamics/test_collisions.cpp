@@ -175,7 +175,7 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
     // about it without a trend. With arms spun at tens of rad/s that reached 1.85 times the allowance
     // below within a second with no contact at all (seed 7, cycle 59, after the joint-impulse guess of
     // 2026-11-25), so a comparison of the first and last step's energies failed on 1 of 13 seeds of this
-    // shaking both before and after that change (docs/performance.md, "2026-11-25: the guess"). Compared
+    // shaking both before and after that change (docs/performance.md, "2026-11-25, later"). Compared
     // instead: the mean energy over the first and the last quarter of the second (worst over 13 seeds:
     // 0.60 of the allowance before the change, 0.37 after). A gain from contacts (a bounce, the overlap
     // push) stays in the energy and shows in the later mean.
