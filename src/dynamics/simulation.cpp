@@ -426,7 +426,7 @@ inline double widest(double worst, double gap) { return gap > worst || !std::isf
 // A pass of rattle()'s drift over all bodies (drift_body, parents first). The first of a step also forms
 // each body's drift_map (see rattle's step 2) from the kicked velocities, just before drifting it.
 // Returns the largest joint gap (m, per coordinate; NaN stays NaN).
-double Simulation::drift_pass(double h, bool first_of_step, bool with_pseudo) {
+ALOFT_CPU_DISPATCH double Simulation::drift_pass(double h, bool first_of_step, bool with_pseudo) {
   const int n = model_.count;
   StepWorkspace& work = *work_;
   const State& now = state_;
@@ -485,7 +485,7 @@ bool Simulation::push_apart(double h) {
 // rattle()'s step 1 (and the contacts): the first half kick, with (guess) or without the joint impulses
 // guessed from the last steps, then the contacts' impulses. False, leaving the step to be halved, when
 // the step-size rule or contacts_move_slowly_enough finds h too long for the velocities it made.
-bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo) {
+ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo) {
   const int n = model_.count;
   const std::vector<int>& parent = model_.parent;
   StepWorkspace& work = *work_;
@@ -620,7 +620,7 @@ bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& conta
 
 // One RATTLE step of `h` seconds from state_ into work.next. Returns false, leaving state_ and the
 // factorization untouched, when the joint impulses do not converge (the motion is too fast for h).
-bool Simulation::rattle(double h) {
+ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   const int n = model_.count;
   StepWorkspace& work = *work_;
   const State& now = state_;

@@ -33,6 +33,7 @@
 
 
 #include "aloft/state.hpp"
+#include "common/cpu_dispatch.hpp"
 #include "dynamics/small_matrix.hpp"
 
 namespace aloft {
@@ -176,7 +177,7 @@ class TreeSolver {
   // visit. (y_[i] holds (c_i, e_i) from the tip-to-base sweep.) kSparse: y_ and a_ hold values only where
   // on_path_ is set (solve_sparse), and are taken as zero elsewhere.
   template <bool kSparse = false, class Visit>
-  void substitute(Visit& visit) {
+  ALOFT_CPU_DISPATCH void substitute(Visit& visit) {
     const std::vector<int>& parent = model_.parent;
     for (int i = 1; i < n_; ++i) {
       const int p = parent[i];
@@ -243,7 +244,7 @@ Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
 // With kEliminate, body i's step of eliminate() (c_i = 0) follows at once, on the blocks still at hand.
 // With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
 template <bool kEliminate, bool kStack, class Wrench>
-void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench) {
+ALOFT_CPU_DISPATCH void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench) {
   const std::vector<int>& parent = model_.parent;
   int top = 0;  // kStack: folded_[1..top] in use
   for (int i = n_ - 1; i >= 1; --i) {
