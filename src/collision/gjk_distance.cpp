@@ -168,7 +168,11 @@ GjkResult gjk_distance(const ConvexPiece& a, const Pose& pa, const ConvexPiece& 
     const Vertex x = support(a, pa, b, pb, v, core_a, core_b);
     ++r.iterations;
     // Every point p of a - b has p.v >= x.w.v (x.w is the support against v).
-    r.lower = std::max(r.lower, v.dot(x.w) / std::sqrt(vv));
+    const double separation = v.dot(x.w) / std::sqrt(vv);
+    if (separation > r.lower) {
+      r.lower = separation;
+      r.lower_direction = v / std::sqrt(vv);
+    }
     // No progress: v is (to a relative 1e-12 of |v|^2) the closest point of A - B.
     if (vv - v.dot(x.w) <= 1e-12 * vv) break;
     bool repeated = false;

@@ -18,6 +18,11 @@ struct GjkResult {
   // converged; below it when GJK stopped at its iteration limit, as it can on a wire's round side lying
   // along a plate or another wire (seen: 2.01 mm estimated, 1.57 mm certain, after 64 iterations).
   double lower = 0;
+  // The search direction that separation was seen along (world, unit, from b towards a): the pieces lie
+  // on either side of a band `lower` wide across it. Where GJK stops short of converging, the closest
+  // points above can be far from the true ones (on two wires with an end involved, their direction has
+  // been 80 degrees off), while this direction separates the pieces by exactly the certified gap.
+  Vec3 lower_direction = Vec3::UnitX();
   int iterations = 0;  // support points taken (at most 64)
 };
 
