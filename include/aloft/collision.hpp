@@ -58,15 +58,17 @@ struct Contact {
   Vec3 point = Vec3::Zero();     // world, m: midway between the two closest (or deepest) points
   Vec3 normal = Vec3::UnitY();   // world, unit, pointing from b towards a: a separates along +normal
   double distance = 0;           // m: signed gap along the normal; < 0 when the shapes overlap (depth)
-  // m: the largest distance from a's (b's) centre of mass to the convex piece of a (b) in contact, which
-  // bounds how far that piece's points travel in a step (|v| + |w| reach); infinite when not known (the
-  // component's reach then bounds it).
+  // m: the largest distance from a's (b's) centre of mass to the near part of its pieces in contact
+  // (below), which bounds how far those points travel in a step (|v| + |w| reach); infinite when not
+  // known (the component's reach then bounds it).
   double reach_a = INFINITY, reach_b = INFINITY;
-  // A box enclosing the convex pieces of a (b) found within the margin of the other component's (the
-  // pieces reach_a, reach_b are taken over), in a's (b's) body frame (principal axes, origin at the
-  // centre of mass; m): the fastest point of those pieces at velocities v, w is at one of its corners,
-  // |v + w x corner| (Simulation's limit on how far pieces in contact travel). Empty (low > high) when
-  // not known.
+  // A box enclosing the near part of the convex pieces of a (b) found within the margin of the other
+  // component's: the points of each such piece within the pair's margin of its partner piece, the only
+  // ones that can meet it within the step (collision/near_part.hpp; the margin bounds how far any point
+  // moves towards the other component). In a's (b's) body frame (principal axes, origin at the centre of
+  // mass; m): the fastest of those points at velocities v, w is at one of its corners, |v + w x corner|
+  // (Simulation's limits on how far pieces in contact travel and how much deeper they get). Empty
+  // (low > high) when not known.
   Vec3 near_low_a = Vec3::Constant(INFINITY), near_high_a = Vec3::Constant(-INFINITY);
   Vec3 near_low_b = Vec3::Constant(INFINITY), near_high_b = Vec3::Constant(-INFINITY);
   // m: the smallest half-width (half the smallest width: a wire's radius, half a plate's thickness) of
@@ -98,6 +100,15 @@ class CollisionDetector {
   // closed the gap (on by default; detector.cpp, "Coherence"). It never changes the contacts found, only
   // the time taken: off is for checking that, and for measuring what it saves.
   void set_coherence(bool on);
+
+  // The signed distance (m, < 0 when they overlap: minus the depth) between the shapes of components a
+  // and b placed at the given poses (centre of mass, orientation of the principal frame; world), exact
+  // (as find_contacts measures it) where it is below `near` (> 0), and otherwise a lower bound of at least
+  // `near`. Looks at every pair of their convex pieces whose enclosing spheres come within `near`; the
+  // fixed component's pose is whatever is passed. For Simulation's check of a contact's motion through a
+  // step (dynamics/contact_sweep.hpp).
+  double signed_distance(int a, const Vec3& position_a, const Quat& orientation_a, int b, const Vec3& position_b,
+                         const Quat& orientation_b, double near) const;
 
   // Contacts of `state` whose signed distance is below
   //     base_margin + step * (speed bound of a + speed bound of b),

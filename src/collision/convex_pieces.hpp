@@ -33,6 +33,9 @@ struct ConvexPiece {
   // Directions worth testing as a separating axis (body frame, unit, sign irrelevant): a polytope's face
   // normals, a cylinder's axis. The overlap test checks them besides EPA's answer (gjk_contact.cpp).
   std::vector<Vec3> axes;
+  // A polytope's extent along each of its axes: axis_low[k] <= axes[k] . p <= axis_high[k] for every
+  // point p of the piece (body frame, m; the slabs near_part.hpp cuts with). Empty for round pieces.
+  std::vector<double> axis_low, axis_high;
   // The directions of the piece's edges (body frame, unit, sign irrelevant; a cylinder's axis). For two
   // polytopes, the separating axis is one of the face normals or the cross product of an edge direction
   // of each (the separating axis theorem), so with these the overlap test's candidates are complete.

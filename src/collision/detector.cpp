@@ -32,6 +32,7 @@
 #include "aloft/model.hpp"
 #include "collision/broad_phase.hpp"
 #include "collision/narrow_phase.hpp"
+#include "collision/near_part.hpp"
 #include "collision/prune.hpp"
 
 namespace aloft {
@@ -156,18 +157,25 @@ struct CollisionDetector::Impl {
         }
       }
     }
-    // Every contact of the pair carries the largest reach, a box around and the smallest half-width of
-    // all the pieces found near each other, including any the cut below drops (their travel must be
-    // bounded too).
+    // Every contact of the pair carries a box around, and the largest reach of, the parts of the pieces
+    // found near each other that lie within the pair's margin of their partner (near_part.hpp: only
+    // those can meet it within the step), and the smallest half-width of those pieces, over all of them,
+    // including any the cut below drops (their travel must be bounded too).
     double reach_a = 0, reach_b = 0, thinnest = INFINITY;
     Vec3 low_a = Vec3::Constant(INFINITY), high_a = Vec3::Constant(-INFINITY);
     Vec3 low_b = low_a, high_b = high_a;
+    const auto farthest_corner = [](const Vec3& low, const Vec3& high) {
+      return low.cwiseAbs().cwiseMax(high.cwiseAbs()).norm();
+    };
     for (const Found& f : found) {
-      reach_a = std::max(reach_a, f.piece_a->reach);
-      reach_b = std::max(reach_b, f.piece_b->reach);
+      Vec3 la, ha, lb, hb;
+      internal::near_part_box(*f.piece_a, pose[a], *f.piece_b, pose[b], pair_margin, la, ha);
+      internal::near_part_box(*f.piece_b, pose[b], *f.piece_a, pose[a], pair_margin, lb, hb);
+      reach_a = std::max(reach_a, std::min(f.piece_a->reach, farthest_corner(la, ha)));
+      reach_b = std::max(reach_b, std::min(f.piece_b->reach, farthest_corner(lb, hb)));
       thinnest = std::min({thinnest, f.piece_a->half_width, f.piece_b->half_width});
-      low_a = low_a.cwiseMin(f.piece_a->box_low), high_a = high_a.cwiseMax(f.piece_a->box_high);
-      low_b = low_b.cwiseMin(f.piece_b->box_low), high_b = high_b.cwiseMax(f.piece_b->box_high);
+      low_a = low_a.cwiseMin(la), high_a = high_a.cwiseMax(ha);
+      low_b = low_b.cwiseMin(lb), high_b = high_b.cwiseMax(hb);
     }
     const bool complete = found.size() <= kMaxContactsPerPair;
     if (found.size() > kMaxContactsPerPair) {
@@ -222,6 +230,24 @@ double CollisionDetector::margin(int component, const Vec3& velocity, const Vec3
 }
 
 void CollisionDetector::set_coherence(bool on) { impl_->coherence = on; }
+
+double CollisionDetector::signed_distance(int a, const Vec3& position_a, const Quat& orientation_a, int b,
+                                          const Vec3& position_b, const Quat& orientation_b, double near) const {
+  const Impl& d = *impl_;
+  const Pose pose_a{orientation_a.toRotationMatrix(), position_a}, pose_b{orientation_b.toRotationMatrix(), position_b};
+  double least = near;
+  internal::PieceContact c;
+  for (const ConvexPiece& x : d.geometry[a].pieces) {
+    const Vec3 center_x = pose_a.to_world(x.bound_center);
+    for (const ConvexPiece& y : d.geometry[b].pieces) {
+      const double reach = x.bound_radius + y.bound_radius + near;
+      if ((center_x - pose_b.to_world(y.bound_center)).squaredNorm() > reach * reach) continue;
+      // Below `near` the distance is the narrow phase's measurement; otherwise a lower bound >= near.
+      if (internal::piece_contact(x, pose_a, y, pose_b, near, c)) least = std::min(least, c.distance);
+    }
+  }
+  return least;
+}
 
 void CollisionDetector::find_contacts(const State& state, double step, double base_margin,
                                       std::vector<Contact>& contacts) {
