@@ -47,9 +47,13 @@ double contact_deepening_bound(const Contact& contact, const ContactSide& a, con
   // Both frames: each body's arcs and precession.
   const double curvature = (precession_a + 0.5 * theta_a * theta_a) * a.reach +
                            (precession_b + 0.5 * theta_b * theta_b) * b.reach;
-  const double closing =
-      approach ? std::max(0.0, -h * relative_velocity.dot(n) - std::max(contact.distance, 0.0)) : 0.0;
-  return closing + std::min(in_b_frame, in_a_frame) + curvature;
+  // Every point of either piece starts at least the gap from the other's supporting plane, and moves
+  // towards it by at most the approach at p (which may be negative: separating) plus the turn and the
+  // curvature allowance: only what exceeds the gap sinks past the plane. Without the approach (before the
+  // contact impulses, which let the contact close at most its gap), the approach is taken as the gap.
+  const double gap = std::max(contact.distance, 0.0);
+  const double closing = approach ? -h * relative_velocity.dot(n) : gap;
+  return std::max(0.0, closing + std::min(in_b_frame, in_a_frame) + curvature - gap);
 }
 
 }  // namespace aloft

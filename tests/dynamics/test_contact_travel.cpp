@@ -168,19 +168,17 @@ TEST(ContactTravel, BoundsTheOverlapAfterTheDrift) {
     ASSERT_LE(excess, 1e-12) << "trial " << trial << ": overlap " << after << " m after, distance "
                              << s.contact.distance << " m before, bound " << bound << " m";
     worst_excess = std::max(worst_excess, excess);
-    const bool turning_only = contact_deepening_bound(s.contact, s.a.side(), s.b.side(), kStep, false) == bound;
     if (after > std::max(0.0, -s.contact.distance) + 1e-6) {
       ++deepened;
-      if (turning_only) tightest = std::max(tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
+      tightest = std::max(tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
     }
   }
-  // The test must probe the bound, not pass far below it: many trials deepen, and where no approach
-  // counts (the deepening is the turn's alone, which the bound takes to first order exactly) the deepest
-  // comes near the bound: the curvature allowance is generous, not loose.
+  // The test must probe the bound, not pass far below it: many trials deepen, and the deepest comes near
+  // the bound (the approach, the gap and the turn are taken to first order exactly; the curvature
+  // allowance is generous, not loose). Measured: 7923 trials deepen, the largest by 1.000 of the bound.
   EXPECT_GT(deepened, 2000);
-  EXPECT_GT(tightest, 0.5);
-  std::printf("deepened %d of 20000; largest deepening / bound where only turns count %.3f; closest approach to "
-              "the bound %.3g m\n",
+  EXPECT_GT(tightest, 0.9);
+  std::printf("deepened %d of 20000; largest deepening / bound %.3f; closest approach to the bound %.3g m\n",
               deepened, tightest, worst_excess);
 }
 
