@@ -121,8 +121,8 @@ class Simulation {
 
  private:
   bool rattle(double h);
-  bool contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular,
-                                   bool after_impulses) const;
+  bool contacts_turn_slowly_enough(double h, const std::vector<Vec3>& angular) const;
+  bool contacts_move_slowly_enough(double h, bool pushed) const;
   bool advance_by(double h, int depth);
   // rattle()'s drift (see simulation.cpp): a plain pass, and a Newton correction of the half-step
   // velocities or of the pseudo-velocities followed by a pass.

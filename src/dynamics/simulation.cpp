@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "dynamics/contact_response.hpp"
+#include "dynamics/contact_sweep.hpp"
 #include "dynamics/contact_travel.hpp"
+#include "dynamics/rotation.hpp"
 #include "dynamics/step_size_rule.hpp"
 #include "dynamics/tree_solver.hpp"
 
@@ -50,7 +52,8 @@ constexpr int kStepsBeforeCoarser = 4;
 // A step with collisions on is accepted (contacts_move_slowly_enough) when, for every contact, either
 // the pieces can get at most kDeepeningPerHalfWidth times the thinnest one's half-width (and at most
 // kMaxContactTravel) deeper into each other (contact_deepening_bound), or no point of them travels more
-// than kMaxContactTravel.
+// than kMaxContactTravel, or, where neither holds, the pair's motion through the step, sampled
+// (sweep_contact), takes it no deeper than the first allows.
 //  - kMaxContactTravel (m): a third of the thinnest sheet of the presets (1.5 mm). Measured on the Steel
 //    Fish shaken hard for 600 s: with no such limit, pieces knocked at 2-5 m/s overlapped by up to 4.2 mm
 //    within a step; with 0.5 mm, by less than a micrometre (1 mm still let 1.5 mm through). (Since then,
@@ -65,7 +68,9 @@ constexpr int kStepsBeforeCoarser = 4;
 //    passing accepts the step. Measured from the benchmarks' swinging state, generated-1023, 5000 steps:
 //    halvings 2.83 per step with the travel limit alone, 1.86 with a flat 0.25 mm limit on the deepening
 //    too, 1.62 with this one; the shaken Steel Fish's deepest transient overlap 0.294, 0.263 and 0.383 mm
-//    (its threads' radius is 0.6 mm, its plates 0.75-1.25 mm thick on each side).
+//    (its threads' radius is 0.6 mm, its plates 0.75-1.25 mm thick on each side). With the near parts
+//    and the sampled motion (2026-12-02): 0.081 halvings per step; 0.48-0.61 mm over 24 seeds of the
+//    shaking (docs/collisions.md, "Checking the motion itself").
 constexpr double kMaxContactTravel = 5e-4;
 constexpr double kDeepeningPerHalfWidth = 0.5;
 // Contacts are looked for within this distance (m) plus what the pair can close in one step. Half a
@@ -158,35 +163,6 @@ struct StepWorkspace {
 };
 
 namespace {
-
-// exp(theta / 2) q, renormalised: the orientation q turned by the rotation vector `theta` (rad, world).
-// Written out in scalars (the quaternion product vectorises poorly at this size).
-[[gnu::always_inline]] inline Quat turned(const Vec3& theta, const Quat& q) {
-  const double a2 = theta.squaredNorm();
-  double c, s;
-  if (a2 < 1e-4) {
-    // Taylor series of cos(a/2) and sin(a/2)/a to a^4; the first neglected terms are below
-    // a^6/46080 < 3e-17 for a < 1e-2.
-    c = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
-    s = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
-  } else {
-    const double a = std::sqrt(a2);
-    c = std::cos(0.5 * a);
-    s = std::sin(0.5 * a) / a;
-  }
-  const double x = s * theta.x(), y = s * theta.y(), z = s * theta.z();
-  // (c, v) (w, u) = (c w - v.u, c u + w v + v x u)
-  const double rw = c * q.w() - (x * q.x() + y * q.y() + z * q.z());
-  const double rx = c * q.x() + q.w() * x + (y * q.z() - z * q.y());
-  const double ry = c * q.y() + q.w() * y + (z * q.x() - x * q.z());
-  const double rz = c * q.z() + q.w() * z + (x * q.y() - y * q.x());
-  // Both factors are unit to rounding, so |r|^2 = 1 + e with |e| ~ 1e-16: one Newton step for
-  // 1/sqrt(1 + e), (3 - |r|^2) / 2, renormalises to O(e^2) ~ 1e-32 without a square root or a division.
-  // (An orientation set from outside that is not unit, |e| >= 1e-8, is normalised exactly.)
-  const double norm2 = rw * rw + rx * rx + ry * ry + rz * rz;
-  const double inverse_norm = std::abs(norm2 - 1.0) < 1e-8 ? 0.5 * (3.0 - norm2) : 1.0 / std::sqrt(norm2);
-  return Quat(rw * inverse_norm, rx * inverse_norm, ry * inverse_norm, rz * inverse_norm);
-}
 
 // Whether the Newton iteration on the joints should stop trying this h: too many iterations, a
 // non-finite gap, or (from the third pass on) a gap that did not at least halve.
@@ -310,43 +286,93 @@ double fastest_corner_speed(const Quat& orientation, const Vec3& v, const Vec3& 
   return std::sqrt(fastest);
 }
 
+// The largest speed (m/s) of a corner of the box [low, high] (as above) due to the turn w alone:
+// max |w x r| over the 8 corners r, which bounds |w x r| over the box (a convex function of r).
+double fastest_turn_speed(const Quat& orientation, const Vec3& w, const Vec3& low, const Vec3& high) {
+  const Vec3 w_body = orientation.conjugate() * w;
+  double fastest = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 r(corner & 1 ? high.x() : low.x(), corner & 2 ? high.y() : low.y(), corner & 4 ? high.z() : low.z());
+    fastest = std::max(fastest, w_body.cross(r).squaredNorm());
+  }
+  return std::sqrt(fastest);
+}
+
 }  // namespace
 
-// With collisions on: whether, for every contact found for this step, neither component turns more than
-// kOldTurnLimit in a step of h, and either its pieces can get at most kDeepeningPerHalfWidth of the
-// thinnest one's half-width deeper into each other (contact_deepening_bound, at the given velocities;
-// with `after_impulses` false, before the contact impulses, the approach is left out: the impulses will
-// stop it), or no point of them travels more than kMaxContactTravel. A contact is a constraint at one
-// point with one normal, from the closest features at the start of the step; a plate edge sweeping
-// several millimetres per step past a 2 mm wire can pierce it away from that point before the next step
-// sees it. Always true for the shortest step the subdivision allows (it must make progress).
-bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& velocity,
-                                              const std::vector<Vec3>& angular, bool after_impulses) const {
+// With collisions on: whether every pair of components in contact turns at most kOldTurnLimit in a step
+// of h at these angular velocities. The drift-error rule alone lets a fast spinner turn up to kMaxTurn (4
+// times more); a component a knock sends spinning, or that the joints' corrections speed up after
+// detection, then sweeps past the contacts found at the start of the step: on the Steel Fish shaken hard,
+// overlaps of 9-18 mm within 80 s with the drift-error rule alone, none above 0.4 micrometres in 120 s
+// with this limit too. (It also keeps contact_deepening_bound's second-order terms small.) A component in
+// no contact needs no such limit: the detection margin, h (|v| + |w| reach), covers its whole sweep, so
+// anything it could reach in the step is a contact of its own. (Until 2026-11-24 the limit held for every
+// component: generated-1023, 5000 steps from the swinging state, 1.62 -> 1.56 halvings per step without
+// it for the components in no contact.) Always true for the shortest step the subdivision allows (it must
+// make progress).
+bool Simulation::contacts_turn_slowly_enough(double h, const std::vector<Vec3>& angular) const {
+  if (at_finest_step(h)) return true;
+  for (const Contact& c : work_->contacts)
+    if (!(c.a == 0 || h * angular[c.a].norm() <= kOldTurnLimit) || !(h * angular[c.b].norm() <= kOldTurnLimit))
+      return false;
+  return true;
+}
+
+// With collisions on, once the step's drift is done (rattle's steps 2 and 2b): whether the contacts found
+// for this step allow the drift just taken from state_: every body moved by h times its half-step velocity
+// work.next.velocity and turned by h times its drift angular velocity w_m = work.drift_map
+// work.next.angular, and, when `pushed`, also moved by h times the overlap push's pseudo-velocity
+// work.pseudo (its turn after the drift's). These are the step's final motions: the contact impulses, the
+// joints' corrections and the contacts' corrections after them, and the push. (Until 2026-12-02 this was
+// checked on the velocities right after the contact impulses, which the joints' corrections and the push
+// then changed: on the shaken Steel Fish, pairs ended up to 0.84 mm deep where their check allowed 0.4
+// mm, mostly by the push, which is solved for the contacts' points and normals at the start of the step.)
+// A contact is a constraint at one point with one normal, from the closest features at the start of the
+// step; a plate edge sweeping several millimetres per step past a 2 mm wire can pierce it away from that
+// point before the next step sees it. Every pair in contact must turn little
+// (contacts_turn_slowly_enough), and each contact must either
+//   - travel little: no point of the near parts of its pieces (Contact::near_low_a ...) moves more than
+//     kMaxContactTravel, or
+//   - deepen little: its pieces can get at most kDeepeningPerHalfWidth of the thinnest one's half-width
+//     (and at most kMaxContactTravel) deeper into each other (contact_deepening_bound), or, where neither
+//     bound does for some contact of a pair,
+//   - the pair's motion through the step, sampled (sweep_contact), takes it no deeper than that.
+// Always true for the shortest step the subdivision allows (it must make progress).
+bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
   const StepWorkspace& work = *work_;
   if (at_finest_step(h)) return true;
-  // The turn of the components in contact: the drift-error rule alone lets a fast spinner turn up to
-  // kMaxTurn (4 times more); a component a knock sends spinning, or that the joints' corrections speed
-  // up after detection, then sweeps past the contacts found at the start of the step: on the Steel Fish
-  // shaken hard, overlaps of 9-18 mm within 80 s with the drift-error rule alone, none above 0.4
-  // micrometres in 120 s with this limit too. (It also keeps contact_deepening_bound's second-order
-  // terms small.) A component in no contact needs no such limit: the detection margin, h (|v| + |w|
-  // reach), covers its whole sweep, so anything it could reach in the step is a contact of its own.
-  // (Until 2026-11-24 the limit held for every component: generated-1023, 5000 steps from the swinging
-  // state, 1.62 -> 1.56 halvings per step without it for the components in no contact.)
-  const auto turns_little = [&](const Contact& c) {
-    return (c.a == 0 || h * angular[c.a].norm() <= kOldTurnLimit) && h * angular[c.b].norm() <= kOldTurnLimit;
+  if (!contacts_turn_slowly_enough(h, work.next.angular)) return false;
+  // Body i's motion in the step: velocity v (the push's included), the drift's turn rate w_m and the
+  // push's w_p. A turn by h w_m and then by h w_p is one by h (w_m + w_p) plus (h^2 / 2) w_p x w_m to
+  // second order (Baker-Campbell-Hausdorff): the bound below takes w_m + w_p, and that difference as the
+  // precession it allows for (ContactSide::precession: how far the turn departs from h times the angular
+  // velocity given). Points move by at most h (|w_m| + |w_p|) times their distance from the centre of mass.
+  struct Motion {
+    Vec3 velocity = Vec3::Zero(), drift = Vec3::Zero(), push = Vec3::Zero();
   };
-  const std::vector<Mat3>& inertia = work.solver.world_inertia();  // at state_'s pose
-  const std::vector<Mat3>& inverse_inertia = work.solver.world_inverse_inertia();
+  const auto motion = [&](int i) {
+    Motion m;
+    if (i == 0) return m;  // the fixed component does not move
+    m.velocity = work.next.velocity[i];
+    m.drift = work.drift_map[i] * work.next.angular[i];
+    if (pushed) {
+      m.velocity += work.pseudo[i].head<3>();
+      m.push = work.pseudo[i].tail<3>();
+    }
+    return m;
+  };
+  const auto farthest_corner = [](const Vec3& low, const Vec3& high) {
+    return low.cwiseAbs().cwiseMax(high.cwiseAbs()).norm();
+  };
   const auto side = [&](int i, double contact_reach, const Vec3& low, const Vec3& high) {
+    const Motion m = motion(i);
     ContactSide s;
     s.position = state_.position[i];
     s.orientation = state_.orientation[i];
-    if (i != 0) {  // the fixed component does not move
-      s.velocity = velocity[i];
-      s.angular = angular[i];
-      s.precession = inverse_inertia[i] * angular[i].cross(inertia[i] * angular[i]);
-    }
+    s.velocity = m.velocity;
+    s.angular = m.drift + m.push;
+    s.precession = m.push.cross(m.drift);
     s.reach = std::min(work.detector->reach(i), contact_reach);
     s.near_low = low;
     s.near_high = high;
@@ -355,20 +381,22 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
   // How far any point of the pieces in contact travels, from the speed of their fastest point: at most
   // |v| + |w| times the pieces' reach from the centre of mass, and at most the fastest corner of the box
   // around them, |v + w x corner| (sharper for a piece turning about an axis through or near it, as a
-  // plate spinning on its thread). Any other piece of the pair that could come near within the step is
-  // within the detection margin, which the component's whole reach sets, so it is a contact of its own,
-  // checked here too.
+  // plate spinning on its thread; to first order in the turn). Any other piece of the pair that could come
+  // near within the step is within the detection margin, which the component's whole reach sets, so it is
+  // a contact of its own, checked here too.
   const auto travels_little = [&](const Contact& c) {
     for (int k = 0; k < 2; ++k) {
       const int i = k == 0 ? c.a : c.b;
       if (i == 0) continue;
+      const Motion m = motion(i);
       const double reach = std::min(work.detector->reach(i), k == 0 ? c.reach_a : c.reach_b);
-      const double speed = velocity[i].norm() + angular[i].norm() * reach;
-      if (h * speed <= kMaxContactTravel) continue;
+      const double turn = m.drift.norm() + m.push.norm();
+      if (h * (m.velocity.norm() + turn * reach) <= kMaxContactTravel) continue;
       const Vec3& low = k == 0 ? c.near_low_a : c.near_low_b;
       const Vec3& high = k == 0 ? c.near_high_a : c.near_high_b;
       if (!(low.x() <= high.x()) ||
-          h * fastest_corner_speed(state_.orientation[i], velocity[i], angular[i], low, high) > kMaxContactTravel)
+          h * (fastest_corner_speed(state_.orientation[i], m.velocity, m.drift, low, high) +
+               m.push.norm() * farthest_corner(low, high)) > kMaxContactTravel)
         return false;
     }
     return true;
@@ -380,10 +408,47 @@ bool Simulation::contacts_move_slowly_enough(double h, const std::vector<Vec3>& 
       return false;
     const double allowed = std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
     return contact_deepening_bound(c, side(c.a, c.reach_a, c.near_low_a, c.near_high_a),
-                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, after_impulses) <= allowed;
+                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, true) <= allowed;
   };
-  for (const Contact& c : work.contacts)
-    if (!turns_little(c) || (!travels_little(c) && !deepens_little(c))) return false;
+  // The pair's motion as the step moved it, and how far any point of each near part moved: at most
+  // h (|v| + max |w_m x r| + |w_p| |r|) over the near box's corners r (|w x r| is convex in r, and turning
+  // the arm r about w does not change it), or h (|v| + (|w_m| + |w_p|) reach) where no box is known.
+  const auto swept = [&](int i, double contact_reach, const Vec3& low, const Vec3& high) {
+    const Motion m = motion(i);
+    SweptBody body;
+    body.fixed = i == 0;
+    body.position = state_.position[i];
+    body.orientation = state_.orientation[i];
+    body.velocity = m.velocity;
+    body.drift_angular = m.drift;
+    body.push_angular = m.push;
+    const double turning =
+        low.x() <= high.x()
+            ? fastest_turn_speed(state_.orientation[i], m.drift, low, high) + m.push.norm() * farthest_corner(low, high)
+            : (m.drift.norm() + m.push.norm()) * std::min(work.detector->reach(i), contact_reach);
+    body.travel = h * (m.velocity.norm() + turning);
+    return body;
+  };
+  const std::vector<Contact>& contacts = work.contacts;  // sorted by (a, b)
+  for (std::size_t first = 0, last; first < contacts.size(); first = last) {
+    // The contacts of one pair: [first, last).
+    bool bounded = true;
+    double start_overlap = 0;
+    for (last = first; last < contacts.size() && contacts[last].a == contacts[first].a &&
+                       contacts[last].b == contacts[first].b;
+         ++last) {
+      const Contact& c = contacts[last];
+      bounded = bounded && (travels_little(c) || deepens_little(c));
+      start_overlap = std::max(start_overlap, -c.distance);
+    }
+    if (bounded) continue;
+    const Contact& c = contacts[first];  // the pair's near boxes, reach and thinnest are the same in each
+    const double allowed = std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
+    const SweepResult sweep =
+        sweep_contact(*work.detector, c.a, swept(c.a, c.reach_a, c.near_low_a, c.near_high_a), c.b,
+                      swept(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, start_overlap, allowed, c.thinnest);
+    if (!sweep.shallow) return false;
+  }
   return true;
 }
 
@@ -484,7 +549,7 @@ bool Simulation::push_apart(double h) {
 
 // rattle()'s step 1 (and the contacts): the first half kick, with (guess) or without the joint impulses
 // guessed from the last steps, then the contacts' impulses. False, leaving the step to be halved, when
-// the step-size rule or contacts_move_slowly_enough finds h too long for the velocities it made.
+// the step-size rule or contacts_turn_slowly_enough finds h too long for the velocities it made.
 ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo) {
   const int n = model_.count;
   const std::vector<int>& parent = model_.parent;
@@ -564,7 +629,8 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
     const double slack = work.last_look_found ? kRecheckSlack : 0.0;
     work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
-    if (!contacts_move_slowly_enough(h, probe.velocity, probe.angular, false)) return false;
+    // Components in contact that already turn too fast for h: not worth solving the contacts.
+    if (!contacts_turn_slowly_enough(h, probe.angular)) return false;
     const bool resolved = !work.contacts.empty();  // the impulses below change the velocities
     if (resolved)
       contact_report =
@@ -614,8 +680,10 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
 
   // The step-size rule on the velocities the drift will use.
   if (!spins_ok) return reject_spin(h);
-  // The impulses may have knocked a component in contact faster than the check above allowed.
-  return !collisions_ || contacts_move_slowly_enough(h, next.velocity, next.angular, true);
+  // The impulses may have knocked a component in contact faster than the check above allowed. (How far
+  // the pieces in contact move is checked once the joints are closed, on the drift's final velocities:
+  // contacts_move_slowly_enough, in rattle.)
+  return !collisions_ || contacts_turn_slowly_enough(h, next.angular);
 }
 
 // One RATTLE step of `h` seconds from state_ into work.next. Returns false, leaving state_ and the
@@ -711,7 +779,10 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   //     velocity of rest / h: kinetic energy from nothing, more the more a step is halved. (On
   //     generated-1023 after a breeze, this alone moved the failure described above from t = 0.6 s to
   //     0.8 s.) If the pass does not close the joints, the overlap is left for the next step.
-  if (has_pseudo && !push_apart(h)) drift_pass(h, false, false);
+  const bool pushed = has_pseudo && push_apart(h);
+  if (has_pseudo && !pushed) drift_pass(h, false, false);
+  // The step's motion is final: whether the pieces in contact moved slowly enough for h.
+  if (collisions_ && !work.contacts.empty() && !contacts_move_slowly_enough(h, pushed)) return false;
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
