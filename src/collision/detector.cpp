@@ -14,15 +14,24 @@
 // deepest, in piece order. Contacts come out sorted by (a, b), so the same state gives the same contacts
 // in the same order.
 //
-// Coherence. Between calls the pieces move little, and most piece pairs the narrow phase looks at are
-// apart by more than the margin, step after step (a plate beside its sibling). For those, piece_contact()
-// leaves a lower bound of their distance. Each component carries an odometer: the sum, over calls, of how
-// far any point of it moved since the call before (|dx| + 2 sin(angle / 2) reach, exact bound for a rigid
-// motion). A piece pair measured at distance d is apart by at least d - (what both odometers added since),
-// so while that exceeds the margin (and the distance's own error, kCoherenceSlack), it cannot be in
-// contact and is not measured again. This skips only pairs that would give no contact: the contacts are
-// the same as without it. The bounds live in a direct-mapped table (a slot per hash of the piece pair,
-// overwritten on a clash), sized once: no allocation, and a clash only costs a measurement.
+// Coherence. Between calls the pieces move little. Each component carries an odometer: the sum, over
+// calls, of how far any point of it moved since the call before (|dx| + 2 sin(angle / 2) reach, exact
+// bound for a rigid motion). Two things rest on it:
+//  - The pair list. The broad phase runs on boxes grown by each component's margin plus a skin, and its
+//    candidate pairs are kept from call to call. A pair left out was farther apart than the two grown
+//    margins, so it can come within the margins of a later call only if a component moved by more than
+//    its skin, or its margin grew by more, since the list was made: until then the list holds every pair
+//    that can give a contact, and the broad phase and the filter are not run again. The skin is a few
+//    steps of each component's own motion (kSkinSteps), at least kSkinMin.
+//  - Distances. Most piece pairs the narrow phase looks at are apart by more than the margin, step after
+//    step (a plate beside its sibling). For those, piece_contact() leaves a lower bound of their
+//    distance, kept with the pair. A piece pair measured at distance d is apart by at least d - (what both
+//    odometers added since), so while that exceeds the margin (and the distance's own error,
+//    kCoherenceSlack), it cannot be in contact and is not measured again; and while the least of those
+//    bounds over a pair's pieces does, the pair is not looked at at all.
+// Both skip only pairs that would give no contact: the contacts are the same as without them (a fresh
+// detector, or one with set_coherence(false), which runs the broad phase on the margins alone at every
+// call and measures every piece pair).
 
 #include <algorithm>
 #include <cmath>
@@ -45,11 +54,30 @@ constexpr std::size_t kMaxContactsPerPair = 4;
 constexpr double kCoherenceRelativeSlack = 1e-6;
 constexpr double kCoherenceSlack = 1e-9;
 
-// One remembered piece-pair distance.
+// The skin of a component's box in the pair list (see the top of this file): kSkinSteps times how far it
+// moves in a step at its present speed (its margin less the base margin's half), at least kSkinMin (m).
+// The list is made again when some component has moved, or its margin has grown, by more than its skin:
+// a component moving steadily lasts kSkinSteps steps; a larger skin lasts longer but puts more pairs in
+// the list, each looked at (cheaply, while far) at every call. Measured on generated-1023 and 8191 from
+// the benchmarks' swinging state (docs/performance.md, "The pair list"): 8 steps and 2 mm.
+constexpr double kSkinSteps = 8;
+constexpr double kSkinMin = 2e-3;
+
+// One remembered piece-pair distance: a lower bound of the signed distance when measured (m), -infinity
+// when none is known (never measured, or in contact), and the two components' odometers then (m).
 struct DistanceBound {
-  std::uint64_t key = ~std::uint64_t{0};  // which piece pair (none yet)
-  double distance = 0;                    // m: lower bound of the signed distance when measured
-  double odometer_a = 0, odometer_b = 0;  // the components' odometers then (m)
+  double distance = -INFINITY;
+  double odometer_a = 0, odometer_b = 0;
+};
+
+// A candidate pair of the list: its components, where its piece pairs' bounds start (pieces of a times
+// pieces of b of them, b's piece outer), and a lower bound of the pair's distance (the least over its
+// piece pairs; -infinity when unknown) with the odometers it was taken at.
+struct CandidatePair {
+  int a = 0, b = 0;
+  std::uint32_t bounds = 0;
+  double lower = -INFINITY;
+  double odometer_a = 0, odometer_b = 0;
 };
 }  // namespace
 
@@ -78,9 +106,13 @@ struct CollisionDetector::Impl {
   std::vector<Vec3> last_position;
   std::vector<double> odometer;
   bool placed_before = false;
-  std::vector<DistanceBound> bounds;  // size a power of two
-  bool coherence = true;              // skip pairs by the remembered distances (set_coherence)
-  std::uint64_t max_pieces = 1;       // pieces of the component with the most
+  bool coherence = true;              // keep the pair list and skip pairs by their distances (set_coherence)
+  // The pair list, sorted by (a, b), and its piece pairs' distance bounds; per component, the odometer,
+  // margin and skin when the list was made (m).
+  std::vector<CandidatePair> list, next_list;
+  std::vector<DistanceBound> bounds, next_bounds;
+  std::vector<double> listed_odometer, listed_margin, skin;
+  bool listed = false;
 
   // Per-call scratch, indexed by component (sized once).
   std::vector<Pose> pose;
@@ -115,48 +147,96 @@ struct CollisionDetector::Impl {
       last_position[i] = state.position[i];
       pose[i] = {state.orientation[i].toRotationMatrix(), state.position[i]};
       margin[i] = component_margin(g, state.velocity[i], state.angular[i], step, base_margin);
-      broad.box(i) = internal::box_of(pose[i], g.box_center, g.box_half, margin[i]);
     }
     placed_before = true;
   }
 
-  std::size_t slot(std::uint64_t key) const {
-    key ^= key >> 33;  // a mix (splitmix64's finaliser) spreads neighbouring pairs over the table
-    key *= 0xff51afd7ed558ccdULL;
-    key ^= key >> 33;
-    return static_cast<std::size_t>(key & (bounds.size() - 1));
+  // Whether the pair list still holds every pair that can give a contact at this call's poses and
+  // margins: no component has moved, or its margin grown, by more than its skin since it was made.
+  bool list_holds() const {
+    if (!listed || !coherence) return false;
+    for (int i : members)
+      if (odometer[i] - listed_odometer[i] + std::max(0.0, margin[i] - listed_margin[i]) > skin[i]) return false;
+    return true;
   }
 
-  void narrow(int a, int b, std::vector<Contact>& contacts) {
+  // Makes the pair list at this call's poses: the broad phase on the boxes grown by the margins and the
+  // skins (with coherence off, the margins alone), the filter, and for the pairs already in the old list
+  // its remembered distances.
+  void make_list(double base_margin) {
+    for (int i : members) {
+      const ComponentGeometry& g = geometry[i];
+      skin[i] = coherence ? std::max(kSkinMin, kSkinSteps * (margin[i] - 0.5 * base_margin)) : 0.0;
+      broad.box(i) = internal::box_of(pose[i], g.box_center, g.box_half, margin[i] + skin[i]);
+      listed_odometer[i] = odometer[i];
+      listed_margin[i] = margin[i];
+    }
+    broad.sweep(overlaps);
+    next_list.clear();
+    next_bounds.clear();
+    std::size_t old = 0;
+    for (const auto& [a, b] : overlaps) {
+      while (old < list.size() && (list[old].a < a || (list[old].a == a && list[old].b < b))) ++old;
+      const bool kept = old < list.size() && list[old].a == a && list[old].b == b;
+      if (!kept && !is_candidate(a, b)) continue;
+      const std::size_t count = geometry[a].pieces.size() * geometry[b].pieces.size();
+      CandidatePair pair{a, b, static_cast<std::uint32_t>(next_bounds.size())};
+      if (kept) {
+        pair.lower = list[old].lower, pair.odometer_a = list[old].odometer_a, pair.odometer_b = list[old].odometer_b;
+        next_bounds.insert(next_bounds.end(), bounds.begin() + list[old].bounds,
+                           bounds.begin() + list[old].bounds + static_cast<std::ptrdiff_t>(count));
+      } else {
+        next_bounds.resize(next_bounds.size() + count);
+      }
+      next_list.push_back(pair);
+    }
+    std::swap(list, next_list);
+    std::swap(bounds, next_bounds);
+    listed = true;
+  }
+
+  // The contacts of a pair of the list, and its piece pairs' distance bounds brought up to date.
+  void narrow(CandidatePair& pair, std::vector<Contact>& contacts) {
+    const int a = pair.a, b = pair.b;
     const ComponentGeometry &ga = geometry[a], &gb = geometry[b];
     const double pair_margin = margin[a] + margin[b];
     piece_center.resize(ga.pieces.size());
     for (std::size_t k = 0; k < ga.pieces.size(); ++k) piece_center[k] = pose[a].to_world(ga.pieces[k].bound_center);
     found.clear();
     PieceContact c;
+    double lower = INFINITY;  // the least lower bound of the piece pairs' distances, now
+    DistanceBound* bound = bounds.data() + pair.bounds;
     for (std::size_t l = 0; l < gb.pieces.size(); ++l) {
       const ConvexPiece& y = gb.pieces[l];
       const Vec3 cy = pose[b].to_world(y.bound_center);
-      for (std::size_t k = 0; k < ga.pieces.size(); ++k) {
+      for (std::size_t k = 0; k < ga.pieces.size(); ++k, ++bound) {
         const ConvexPiece& x = ga.pieces[k];
-        const double reach = x.bound_radius + y.bound_radius + pair_margin;
-        if ((piece_center[k] - cy).squaredNorm() > reach * reach) continue;
-        const std::uint64_t key =
-            ((static_cast<std::uint64_t>(a) * geometry.size() + static_cast<std::uint64_t>(b)) * max_pieces + k) *
-                max_pieces + l;
-        DistanceBound& bound = bounds[slot(key)];
-        if (coherence && bound.key == key) {
-          const double apart = bound.distance - (odometer[a] - bound.odometer_a) - (odometer[b] - bound.odometer_b);
-          if (apart - kCoherenceRelativeSlack * bound.distance - kCoherenceSlack > pair_margin) continue;
+        const double spheres = (piece_center[k] - cy).norm() - x.bound_radius - y.bound_radius;
+        if (spheres > pair_margin) {
+          lower = std::min(lower, spheres - kCoherenceRelativeSlack * spheres - kCoherenceSlack);
+          continue;
+        }
+        if (coherence) {
+          const double apart = bound->distance - (odometer[a] - bound->odometer_a) - (odometer[b] - bound->odometer_b) -
+                                kCoherenceRelativeSlack * std::abs(bound->distance) - kCoherenceSlack;
+          if (apart > pair_margin) {
+            lower = std::min(lower, apart);
+            continue;
+          }
         }
         if (internal::piece_contact(x, pose[a], y, pose[b], pair_margin, c)) {
           found.push_back({c, &x, &y, static_cast<int>(found.size())});
-          bound.key = ~std::uint64_t{0};
+          bound->distance = -INFINITY;
+          lower = -INFINITY;
         } else {
-          bound = {key, c.distance, odometer[a], odometer[b]};
+          *bound = {c.distance, odometer[a], odometer[b]};
+          lower = std::min(lower, c.distance - kCoherenceRelativeSlack * std::abs(c.distance) - kCoherenceSlack);
         }
       }
     }
+    pair.lower = lower;
+    pair.odometer_a = odometer[a];
+    pair.odometer_b = odometer[b];
     // Every contact of the pair carries a box around, and the largest reach of, the parts of the pieces
     // found near each other that lie within the pair's margin of their partner (near_part.hpp: only
     // those can meet it within the step), and the smallest half-width of those pieces, over all of them,
@@ -208,12 +288,9 @@ CollisionDetector::CollisionDetector(const Model& model)
   d.last_orientation.assign(model.count, Quat::Identity());
   d.last_position.assign(model.count, Vec3::Zero());
   d.odometer.assign(model.count, 0.0);
-  for (const ComponentGeometry& g : d.geometry) d.max_pieces = std::max<std::uint64_t>(d.max_pieces, g.pieces.size());
-  // 16 slots per component with shapes, 1024 to 65536 (32 bytes each, 2 MiB at most): room for the
-  // piece pairs near each other.
-  std::size_t slots = 1024;
-  while (slots < 16 * d.members.size() && slots < 65536) slots *= 2;
-  d.bounds.resize(slots);
+  d.listed_odometer.assign(model.count, 0.0);
+  d.listed_margin.assign(model.count, 0.0);
+  d.skin.assign(model.count, 0.0);
 }
 
 CollisionDetector::~CollisionDetector() = default;
@@ -229,7 +306,10 @@ double CollisionDetector::margin(int component, const Vec3& velocity, const Vec3
   return component_margin(impl_->geometry[component], velocity, angular, step, base_margin);
 }
 
-void CollisionDetector::set_coherence(bool on) { impl_->coherence = on; }
+void CollisionDetector::set_coherence(bool on) {
+  impl_->coherence = on;
+  impl_->listed = false;
+}
 
 double CollisionDetector::signed_distance(int a, const Vec3& position_a, const Quat& orientation_a, int b,
                                           const Vec3& position_b, const Quat& orientation_b, double near) const {
@@ -254,9 +334,37 @@ void CollisionDetector::find_contacts(const State& state, double step, double ba
   Impl& d = *impl_;
   contacts.clear();
   d.place(state, step, base_margin);
-  d.broad.sweep(d.overlaps);
-  for (const auto& [a, b] : d.overlaps)
-    if (d.is_candidate(a, b)) d.narrow(a, b, contacts);
+  if (!d.list_holds()) d.make_list(base_margin);
+  for (CandidatePair& pair : d.list) {
+    if (d.coherence && pair.lower - (d.odometer[pair.a] - pair.odometer_a) - (d.odometer[pair.b] - pair.odometer_b) >
+                           d.margin[pair.a] + d.margin[pair.b])
+      continue;  // every piece pair is still apart by more than the margin
+    d.narrow(pair, contacts);
+  }
+}
+
+void CollisionDetector::find_contacts_again(const std::vector<Contact>& found, const State& state, double step,
+                                            double base_margin, const std::vector<char>& wider,
+                                            std::vector<Contact>& contacts) {
+  Impl& d = *impl_;
+  contacts.clear();
+  d.place(state, step, base_margin);  // the same pose: the odometers stay
+  if (!d.list_holds()) d.make_list(base_margin);
+  std::size_t next = 0;  // the first of `found` not before the pair (both sorted by (a, b))
+  for (CandidatePair& pair : d.list) {
+    const auto before = [&](const Contact& c) { return c.a < pair.a || (c.a == pair.a && c.b < pair.b); };
+    while (next < found.size() && before(found[next])) ++next;
+    const double pair_margin = d.margin[pair.a] + d.margin[pair.b];
+    if (!wider[pair.a] && !wider[pair.b]) {
+      for (; next < found.size() && found[next].a == pair.a && found[next].b == pair.b; ++next)
+        if (found[next].distance < pair_margin) contacts.push_back(found[next]);
+      continue;
+    }
+    if (d.coherence &&
+        pair.lower - (d.odometer[pair.a] - pair.odometer_a) - (d.odometer[pair.b] - pair.odometer_b) > pair_margin)
+      continue;
+    d.narrow(pair, contacts);
+  }
 }
 
 void CollisionDetector::keep_within_margin(const std::vector<Contact>& found, const State& state, double step,

@@ -114,6 +114,7 @@ struct StepWorkspace {
         response(model),
         pseudo(model.count, Vec6::Zero()),
         probe(rest_state(model)),
+        wider(model.count, 0),
         step_rule(model) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
     for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
@@ -153,6 +154,7 @@ struct StepWorkspace {
   std::vector<Contact> nearby;    // found within the margins plus kRecheckSlack (see kick_and_collide)
   bool last_look_found = false;   // the last detection found contacts
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
+  std::vector<char> wider;        // per component: its margin after the impulses is wider than the look's
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
   // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
   // reports. kStepRule: `rejected_body` spins too fast (`rejected_value` its turn per step, rad);
@@ -641,7 +643,8 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
     // is in `nearby`: `aloft_step_profile` after the breeze, collisions on, needed the detector again
     // for 38 of 979 looks on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps);
     // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more);
-    // with the slack only after a look whose contacts had impulses, for 405 and 26.
+    // with the slack only after a look whose contacts had impulses, for 405 and 26. Where some margins did
+    // grow more, only the pairs of those components are looked at again (find_contacts_again).
     work.last_look_found = !work.contacts.empty();
     if (contact_report.active > 0) {
       bool covered = true;  // no component's margin is wider now than in the look `nearby` came from
@@ -650,12 +653,13 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
             work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin + 2 * slack);
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
-        covered = covered && work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin) <= looked;
+        work.wider[i] = work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin) > looked;
+        covered = covered && !work.wider[i];
       }
       if (covered)
         work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
       else
-        work.detector->find_contacts(probe, h, kContactMargin, work.recheck);
+        work.detector->find_contacts_again(work.nearby, probe, h, kContactMargin, work.wider, work.recheck);
       const auto same_pair = [](const Contact& x, const Contact& y) { return x.a == y.a && x.b == y.b; };
       const bool other = work.recheck.size() != work.contacts.size() ||
                          !std::equal(work.recheck.begin(), work.recheck.end(), work.contacts.begin(), same_pair);
