@@ -58,10 +58,14 @@ constexpr double kCoherenceSlack = 1e-9;
 // moves in a step at its present speed (its margin less the base margin's half), at least kSkinMin (m).
 // The list is made again when some component has moved, or its margin has grown, by more than its skin:
 // a component moving steadily lasts kSkinSteps steps; a larger skin lasts longer but puts more pairs in
-// the list, each looked at (cheaply, while far) at every call. Measured on generated-1023 and 8191 from
-// the benchmarks' swinging state (docs/performance.md, "The pair list"): 8 steps and 2 mm.
-constexpr double kSkinSteps = 8;
-constexpr double kSkinMin = 2e-3;
+// the list, each looked at (cheaply, while far) at every call. Callgrind, from the benchmarks' swinging
+// state (aloft_step_profile N STEPS 1 swinging, the same trajectory whatever the skin), instructions:
+//   generated-8191, 1000 steps: 2 steps and 0.5 mm 33.84 G; 4 and 0.5 mm 33.72 G; 4 and 1 mm 33.72 G;
+//   8 and 2 mm 34.61 G;
+//   generated-1023, 5000 steps: 4 and 1 mm 50.01 G; 8 and 2 mm 49.63 G.
+// The larger mobile, which the list helps most, decides: 4 steps and 1 mm.
+constexpr double kSkinSteps = 4;
+constexpr double kSkinMin = 1e-3;
 
 // One remembered piece-pair distance: a lower bound of the signed distance when measured (m), -infinity
 // when none is known (never measured, or in contact), and the two components' odometers then (m).
