@@ -161,7 +161,7 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   const int cycles = 300;
 #endif
   CollisionDetector detector(model);
-  std::vector<Contact> contacts;
+  std::vector<Contact> contacts, earlier;
   for (int cycle = 0; cycle < cycles; ++cycle) {
     for (int burst = 0; burst < 20; ++burst) {
       const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));
@@ -190,6 +190,7 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
       const double energy = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
       if (step < window) start += energy / window;
       if (step >= steps - window) end += energy / window;
+      if (step == steps - 21) detector.find_contacts(sim.state(), 0.0, 1e-3, earlier);
     }
     // Allowed: the integrator's error (1e-4 of the kinetic energy; the conservation test measures far
     // less without contacts) and the lift of the overlap correction, which may raise a piece by its
@@ -200,15 +201,22 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
     ASSERT_LT(max_joint_separation(model, sim.state()), 1e-6) << "cycle " << cycle;
     // Nothing stays inside anything: after a second left alone (no damping: the arms still swing and
     // knock), every pair is apart or touching within a tenth of the 2.5 mm sheet. Transient overlaps
-    // beyond the 0.05 mm slop are removed at 80 % per step, so one that lasts is a piece stuck inside.
+    // beyond the 0.05 mm slop are removed at 80 % per step, so one that lasts is a piece stuck inside:
+    // a pair's overlap counts as the lesser of now and 20 ms before, so that a knock at this very step
+    // does not (seed 6 of this shaking met one 0.24 mm deep that had been 0.045 mm 20 ms before).
     detector.find_contacts(sim.state(), 0.0, 1e-3, contacts);
-    for (const Contact& c : contacts) worst_left_overlap = std::max(worst_left_overlap, -c.distance);
+    for (const Contact& c : contacts) {
+      double before = 0;
+      for (const Contact& e : earlier)
+        if (e.a == c.a && e.b == c.b) before = std::max(before, -e.distance);
+      worst_left_overlap = std::max(worst_left_overlap, std::min(-c.distance, before));
+    }
   }
   const CollisionStatistics& stats = sim.collision_statistics();
   EXPECT_GT(stats.impulses, 100) << "the shaking should make the pieces knock";
   EXPECT_LT(worst_left_overlap, 2.5e-4);
   // Nothing gets through anything, even while knocked about: no contact, at the start of any (sub)step,
-  // is deeper than the thinnest sheet (1.5 mm; measured 0.60 mm, 0.48-0.61 mm over 24 seeds of this
+  // is deeper than the thinnest sheet (1.5 mm; measured 0.58 mm, 0.48-0.61 mm over 24 seeds of this
   // shaking, against 0.29-0.51 mm while every step whose pieces in contact moved too fast for the bounds
   // was halved; docs/collisions.md, "Checking the motion itself"). It was 4-16 mm while GJK's distance
   // estimate, too high where it stopped at its iteration limit, could hide a wire's approach to a plate
@@ -218,8 +226,8 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   EXPECT_LT(stats.deepest, 1.5e-3);
   // Nor past the middle of the thinnest piece near it, where the narrow phase would read the overlap
   // from the far side and the push would drive it through: at the start of every step, no contact's
-  // overlap reaches the smallest half-width of its pair's pieces (Contact::thinnest). Measured 0.60 of
-  // it, 0.50-0.74 over 24 seeds (0.23-0.50 with the halving); 2.1 and 1.36 times it before two narrow
+  // overlap reaches the smallest half-width of its pair's pieces (Contact::thinnest). Measured 0.53 of
+  // it, 0.49-0.72 over 24 seeds (0.23-0.50 with the halving); 2.1 and 1.36 times it before two narrow
   // phase errors on a wire's end were fixed (2026-12-02: a wire's support along its axis, GJK's normal).
   EXPECT_LT(worst_relative_overlap, 1.0);
   // Left alone, the energy never grows by more than allowed above.
