@@ -199,6 +199,13 @@ struct CollisionDetector::Impl {
     listed = true;
   }
 
+  // Whether every piece pair of a pair of the list is still apart by more than the pair's margin: its
+  // least remembered bound, less what both odometers gained since, exceeds it (coherence on).
+  bool still_apart(const CandidatePair& pair) const {
+    return coherence && pair.lower - (odometer[pair.a] - pair.odometer_a) - (odometer[pair.b] - pair.odometer_b) >
+                            margin[pair.a] + margin[pair.b];
+  }
+
   // The contacts of a pair of the list, and its piece pairs' distance bounds brought up to date.
   void narrow(CandidatePair& pair, std::vector<Contact>& contacts) {
     const int a = pair.a, b = pair.b;
@@ -340,10 +347,7 @@ void CollisionDetector::find_contacts(const State& state, double step, double ba
   d.place(state, step, base_margin);
   if (!d.list_holds()) d.make_list(base_margin);
   for (CandidatePair& pair : d.list) {
-    if (d.coherence && pair.lower - (d.odometer[pair.a] - pair.odometer_a) - (d.odometer[pair.b] - pair.odometer_b) >
-                           d.margin[pair.a] + d.margin[pair.b])
-      continue;  // every piece pair is still apart by more than the margin
-    d.narrow(pair, contacts);
+    if (!d.still_apart(pair)) d.narrow(pair, contacts);
   }
 }
 
@@ -364,10 +368,7 @@ void CollisionDetector::find_contacts_again(const std::vector<Contact>& found, c
         if (found[next].distance < pair_margin) contacts.push_back(found[next]);
       continue;
     }
-    if (d.coherence &&
-        pair.lower - (d.odometer[pair.a] - pair.odometer_a) - (d.odometer[pair.b] - pair.odometer_b) > pair_margin)
-      continue;
-    d.narrow(pair, contacts);
+    if (!d.still_apart(pair)) d.narrow(pair, contacts);
   }
 }
 
