@@ -13,7 +13,10 @@
 // simulation (--cache-sim=yes) in minutes.
 //
 // Prints the thread CPU time per step and per moving component-step, the step halvings and tree solves
-// per step, and a checksum of the final state (equal on two runs of one build).
+// per step, and a checksum of the final state (equal on two runs of one build); then, per step, how the
+// (sub)steps went (Simulation::step_statistics): the tries and those taken, the rejections by their
+// cause, the Newton corrections by phase, the contact passes and overlap pushes, and, with collisions
+// on, the (sub)steps whose contact law dropped friction (CollisionStatistics::friction_dropped).
 
 #include <time.h>
 
@@ -88,6 +91,8 @@ int main(int argc, char** argv) {
     }
     sim.set_joint_tolerance(joint_tolerance);
     const long long halvings = sim.subdivisions(), iterations = sim.joint_iterations();
+    const StepStatistics before = sim.step_statistics();
+    const long long friction_dropped_before = sim.collision_statistics().friction_dropped;
     const double start = thread_seconds();
     if (!timed_steps(sim, steps)) throw std::runtime_error(sim.failure()->message);
     const double seconds = thread_seconds() - start;
@@ -98,6 +103,24 @@ int main(int argc, char** argv) {
     std::printf("%s: %.3f us/step, %.4f us per component-step, %.3f halvings and %.2f solves per step; checksum %.17g\n",
                 what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
                 (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
+    const StepStatistics& after = sim.step_statistics();
+    const auto per_step = [&](long long StepStatistics::*count) {
+      return static_cast<double>(after.*count - before.*count) / steps;
+    };
+    std::printf("  per step: %.3f (sub)steps tried, %.3f taken, %.3f kicks retried; rejected: %.3f spin (turn %.3f, anchor %.3f, "
+                "drift %.3f over), %.3f contact turn, %.3f joints, %.3f contact motion\n",
+                per_step(&StepStatistics::attempts), per_step(&StepStatistics::accepted),
+                per_step(&StepStatistics::kicks_retried),
+                per_step(&StepStatistics::rejected_spin), per_step(&StepStatistics::spin_turn_over),
+                per_step(&StepStatistics::spin_anchor_over), per_step(&StepStatistics::spin_drift_over),
+                per_step(&StepStatistics::rejected_contact_turn), per_step(&StepStatistics::rejected_joints),
+                per_step(&StepStatistics::rejected_contact_motion));
+    std::printf("  per step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
+                "pushes; %.3f contact passes, %.3f pushes, %.3f friction dropped\n",
+                per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
+                per_step(&StepStatistics::push_corrections), per_step(&StepStatistics::contact_passes),
+                per_step(&StepStatistics::pushes),
+                static_cast<double>(sim.collision_statistics().friction_dropped - friction_dropped_before) / steps);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aloft_step_profile: %s\n", e.what());
     return 1;

@@ -56,6 +56,29 @@ struct CollisionStatistics {
   double deepest = 0;                 // m, largest overlap seen at the start of a step
 };
 
+// Running totals of how the (sub)steps were taken since the simulation started: what they cost and why
+// some were rejected, for profiling (aloft_step_profile prints them per step). A rejected (sub)step counts
+// once, under the check that rejected it; the Newton corrections (one tree solve each) are counted by
+// the phase of the step they closed the joints in, and add up to Simulation::joint_iterations().
+struct StepStatistics {
+  long long attempts = 0;  // (sub)steps tried
+  long long accepted = 0;  // of those, taken
+  long long kicks_retried = 0;  // half kicks rejected and tried again without the guessed joint impulses
+  // Rejections: the step-size rule on the half-kicked velocities, before or after the contact impulses
+  // (step_size_rule.hpp; the three below count which of its measures were over their limits, so they may
+  // add up to more) ...
+  long long rejected_spin = 0;
+  long long spin_turn_over = 0, spin_anchor_over = 0, spin_drift_over = 0;
+  long long rejected_contact_turn = 0;    // ... a pair in contact turning too fast, before the drift ...
+  long long rejected_joints = 0;          // ... the joints' Newton iteration giving up ...
+  long long rejected_contact_motion = 0;  // ... and the pieces in contact moving too far in the drift.
+  // Newton corrections closing the joints after the step's first drift, after a contact pass, and under
+  // the overlap push (of the pseudo-velocity).
+  long long joint_corrections = 0, contact_pass_corrections = 0, push_corrections = 0;
+  long long contact_passes = 0;  // contacts solved again after the joints' impulses made them approach
+  long long pushes = 0;          // (sub)steps that pushed overlapping pieces apart
+};
+
 struct StepWorkspace;  // solver factorization and scratch (dynamics/simulation.cpp)
 struct ContactStepReport;  // what the contact stage did in one step (dynamics/contact_response.hpp)
 
@@ -118,6 +141,8 @@ class Simulation {
   // How many Newton corrections (one tree solve each) the joint impulses needed, over all steps; a step
   // costs this plus one solve for the velocity projection.
   long long joint_iterations() const;
+  // The same, and more, in detail: see StepStatistics.
+  const StepStatistics& step_statistics() const;
 
  private:
   bool rattle(double h);

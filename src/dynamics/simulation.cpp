@@ -1,6 +1,7 @@
 #include "aloft/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -145,6 +146,10 @@ struct StepWorkspace {
   int deepest = 0;               // the deepest subdivision a substep of this step was taken at
   int settled_steps = 0;         // steps in a row that needed no subdivision deeper than start_depth
   long long joint_iterations = 0;  // SHAKE corrections (tree solves) over all (sub)steps
+  StepStatistics statistics;       // see Simulation::step_statistics
+  // Why rattle() last returned false (counted in `statistics` by advance_by).
+  enum class Outcome { kSpin, kContactTurn, kJoints, kContactMotion } outcome = Outcome::kSpin;
+  std::array<bool, 3> spin_over{};  // for kSpin: which of the rule's measures (turn, anchor, drift) were over
   // Collisions.
   std::unique_ptr<CollisionDetector> detector;  // null while collisions are off
   std::vector<Contact> contacts;  // found at the start of the last (sub)step
@@ -216,6 +221,8 @@ long long Simulation::rejected_substeps() const { return work_->rejected; }
 
 long long Simulation::joint_iterations() const { return work_->joint_iterations; }
 
+const StepStatistics& Simulation::step_statistics() const { return work_->statistics; }
+
 double Simulation::joint_tolerance(double h) const {
   if (fixed_joint_tolerance_ > 0) return fixed_joint_tolerance_;
   return std::max(kJointToleranceFloor, kJointToleranceRate * h * h);
@@ -248,15 +255,19 @@ inline Vec6 Simulation::applied_wrench(const State& state, int i, const Vec3& mo
 // Whether h is the shortest (sub)step the subdivision allows.
 bool Simulation::at_finest_step(double h) const { return !(h > std::ldexp(timestep_, -kMaxSubdivision) * 1.5); }
 
-// The step-size rule rejected the half-kicked velocities work.next.angular: note, for a failure at the
-// shortest step, the body that spins fastest for its limits, and return false.
+// The step-size rule rejected the half-kicked velocities work.next.angular: count which of its measures
+// were over their limits, note, for a failure at the shortest step, the body that spins fastest for its
+// limits, and return false. (Measuring every body costs about a pass over them; rejections are a few per
+// cent of the (sub)steps even where the motion is fastest.)
 bool Simulation::reject_spin(double h) {
   StepWorkspace& work = *work_;
+  const TreeSolver& solver = work.solver;
+  const StepSizeMeasures m = work.step_rule.measure(h, work.next.angular, solver.world_inertia(),
+                                                    solver.world_inverse_inertia(), solver.child_arm(),
+                                                    solver.parent_arm());
+  work.outcome = StepWorkspace::Outcome::kSpin;
+  work.spin_over = {!(m.turn <= 1), !(m.anchor_turn <= 1), !(m.drift_error <= 1)};
   if (at_finest_step(h)) {
-    const TreeSolver& solver = work.solver;
-    const StepSizeMeasures m = work.step_rule.measure(h, work.next.angular, solver.world_inertia(),
-                                                      solver.world_inverse_inertia(), solver.child_arm(),
-                                                      solver.parent_arm());
     int body = m.turn_body;
     double worst = m.turn;
     if (!(m.anchor_turn <= worst)) worst = m.anchor_turn, body = m.anchor_turn_body;
@@ -545,6 +556,7 @@ bool Simulation::push_apart(double h) {
     if (worst <= tolerance) return true;
     if (newton_gives_up(iteration, worst, previous_worst)) return false;
     previous_worst = worst;
+    ++work_->statistics.push_corrections;
     worst = correct_and_drift(h, DriftCorrection::kPseudo, true);
   }
 }
@@ -632,7 +644,10 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
     work.detector->find_contacts(probe, h, kContactMargin + 2 * slack, work.nearby);
     work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.contacts);
     // Components in contact that already turn too fast for h: not worth solving the contacts.
-    if (!contacts_turn_slowly_enough(h, probe.angular)) return false;
+    if (!contacts_turn_slowly_enough(h, probe.angular)) {
+      work.outcome = StepWorkspace::Outcome::kContactTurn;
+      return false;
+    }
     const bool resolved = !work.contacts.empty();  // the impulses below change the velocities
     if (resolved)
       contact_report =
@@ -687,7 +702,11 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
   // The impulses may have knocked a component in contact faster than the check above allowed. (How far
   // the pieces in contact move is checked once the joints are closed, on the drift's final velocities:
   // contacts_move_slowly_enough, in rattle.)
-  return !collisions_ || contacts_turn_slowly_enough(h, next.angular);
+  if (collisions_ && !contacts_turn_slowly_enough(h, next.angular)) {
+    work.outcome = StepWorkspace::Outcome::kContactTurn;
+    return false;
+  }
+  return true;
 }
 
 // One RATTLE step of `h` seconds from state_ into work.next. Returns false, leaving state_ and the
@@ -721,7 +740,9 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     bool suspicious = false;
     for (int i = 1; i < n && !suspicious && work.impulse_step > 0; ++i)
       suspicious = h * (next.angular[i] - now.angular[i]).norm() > kSuspiciousKick;
-    if (!suspicious || !kick_and_collide(h, false, contact_report, has_pseudo)) return false;
+    if (!suspicious) return false;
+    ++work.statistics.kicks_retried;
+    if (!kick_and_collide(h, false, contact_report, has_pseudo)) return false;
   }
 
   // 2. Drift with the half-step velocities, x' = x + h v, q' = exp(h w) q, choosing the joint impulses
@@ -748,6 +769,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
           !work.response.correct(h, next.velocity, next.angular, kContactVelocityTolerance))
         break;
       ++contact_passes;
+      ++work.statistics.contact_passes;
       previous_worst = INFINITY;
       iteration = -1;
       worst = drift_pass(h, false, false);
@@ -755,6 +777,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     }
     // Not converging (too many iterations, growing or non-finite gaps): give up on this h.
     if (newton_gives_up(iteration, worst, previous_worst)) {
+      work.outcome = StepWorkspace::Outcome::kJoints;
       if (at_finest_step(h)) {
         work.rejection = StepWorkspace::Rejection::kJoints;
         work.rejected_value = -1;  // the widest gap, or NaN at the first joint whose gap is not finite
@@ -774,6 +797,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
       return false;
     }
     previous_worst = worst;
+    ++(contact_passes == 0 ? work.statistics.joint_corrections : work.statistics.contact_pass_corrections);
     worst = correct_and_drift(h, DriftCorrection::kVelocity, false);
   }
   // 2b. Overlaps: the split impulse's pseudo-velocity moves the bodies apart on top of the drift. It
@@ -783,10 +807,14 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   //     velocity of rest / h: kinetic energy from nothing, more the more a step is halved. (On
   //     generated-1023 after a breeze, this alone moved the failure described above from t = 0.6 s to
   //     0.8 s.) If the pass does not close the joints, the overlap is left for the next step.
+  work.statistics.pushes += has_pseudo;
   const bool pushed = has_pseudo && push_apart(h);
   if (has_pseudo && !pushed) drift_pass(h, false, false);
   // The step's motion is final: whether the pieces in contact moved slowly enough for h.
-  if (collisions_ && !work.contacts.empty() && !contacts_move_slowly_enough(h, pushed)) return false;
+  if (collisions_ && !work.contacts.empty() && !contacts_move_slowly_enough(h, pushed)) {
+    work.outcome = StepWorkspace::Outcome::kContactMotion;
+    return false;
+  }
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
@@ -842,11 +870,26 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
 bool Simulation::advance_by(double h, int depth) {
   StepWorkspace& work = *work_;
   if (depth >= work.start_depth) {
+    StepStatistics& stats = work.statistics;
+    ++stats.attempts;
     if (rattle(h)) {
+      ++stats.accepted;
       work.deepest = std::max(work.deepest, depth);
       return true;
     }
     ++work.rejected;
+    using Outcome = StepWorkspace::Outcome;
+    switch (work.outcome) {
+      case Outcome::kSpin:
+        ++stats.rejected_spin;
+        stats.spin_turn_over += work.spin_over[0];
+        stats.spin_anchor_over += work.spin_over[1];
+        stats.spin_drift_over += work.spin_over[2];
+        break;
+      case Outcome::kContactTurn: ++stats.rejected_contact_turn; break;
+      case Outcome::kJoints: ++stats.rejected_joints; break;
+      case Outcome::kContactMotion: ++stats.rejected_contact_motion; break;
+    }
   }
   if (depth == kMaxSubdivision) return false;
   if (depth == 0) work_->backup = state_;  // sized once: copying does not allocate after the first time
