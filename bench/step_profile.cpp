@@ -5,8 +5,10 @@
 // step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
 // the function to give callgrind's --toggle-collect.
 //
-//   aloft_step_profile MOBILE STEPS [collisions 0|1] [breeze|swinging] [joint tolerance, m]
+//   aloft_step_profile MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
+//     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
+//       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
 //     joint tolerance: Simulation::set_joint_tolerance for the timed steps (default: the step's rule)
 //
 // The swinging start costs no breeze, so the largest mobiles can be run under callgrind's cache
@@ -52,15 +54,25 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     std::fprintf(stderr,
                  "usage: aloft_step_profile MOBILE(.json or component count) STEPS [collisions 0|1] "
-                 "[breeze|swinging] [joint tolerance, m]\n");
+                 "[breeze|swinging[:SEED]] [joint tolerance, m]\n");
     return 2;
   }
   const std::string what = argv[1];
   const long steps = std::atol(argv[2]);
   const bool collisions = argc > 3 && std::atoi(argv[3]) != 0;
-  const std::string start_from = argc > 4 ? argv[4] : "breeze";
-  if (start_from != "breeze" && start_from != "swinging") {
-    std::fprintf(stderr, "aloft_step_profile: the start is 'breeze' or 'swinging', not '%s'\n", start_from.c_str());
+  const std::string start = argc > 4 ? argv[4] : "breeze";
+  const std::string start_from = start.substr(0, start.find(':'));
+  unsigned long seed = 7;  // bench::swinging_state's default
+  bool seed_ok = true;
+  if (start.find(':') != std::string::npos) {
+    const std::string digits = start.substr(start.find(':') + 1);
+    char* end = nullptr;
+    seed = std::strtoul(digits.c_str(), &end, 10);
+    seed_ok = !digits.empty() && *end == '\0' && start_from == "swinging";
+  }
+  if ((start_from != "breeze" && start_from != "swinging") || !seed_ok) {
+    std::fprintf(stderr, "aloft_step_profile: the start is 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole number), not '%s'\n",
+                 start.c_str());
     return 2;
   }
   const bool swinging = start_from == "swinging";
@@ -76,7 +88,7 @@ int main(int argc, char** argv) {
     } else {
       model = std::move(*bench::generated_model(std::atoi(what.c_str())));  // seed 1
     }
-    Simulation sim(model, swinging ? bench::swinging_state(model) : rest_state(model));
+    Simulation sim(model, swinging ? bench::swinging_state(model, 0.5, seed) : rest_state(model));
     sim.set_collisions(collisions);
     if (swinging) {
       if (!sim.step()) throw std::runtime_error(sim.failure()->message);

@@ -134,6 +134,7 @@ struct StepWorkspace {
   std::vector<Vec3> projection;  // joint impulses of the last step's second half kick (N s), at its end
   std::vector<Vec3> older_projection;  // and of the step before
   double impulse_step = 0;       // the step length (s) impulse and projection belong to
+  bool impulse_after_contacts = false;  // the step `impulse` is from applied contact impulses
   double older_step = 0;         // and the one of older_projection
   std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
   std::vector<Vec3> child_arm;   // at next's pose: R_i joint_in_child[i] (handed to the solver's factor)
@@ -593,9 +594,23 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
   //    guess, that gap was 3380 times the tolerance on generated-65535 and took 3 corrections, against 1
   //    with M_n, and the corrections' impulses stay in the difference term of the steps after:
   //    generated-127, 1000 steps from the swinging state, 1.19 -> 1.12 tree solves per step.)
-  //    Otherwise the last step's P scaled to this step's length. Each body's new angular velocity is
-  //    checked against the step-size rule as it is made (spins_ok), while the body's data are at hand.
-  const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h;
+  //    Otherwise the last step's P scaled to this step's length. After a step with contact impulses,
+  //    P = M_n too: that step's P_n holds the corrections that closed the joints its knocks had opened
+  //    (the contact impulses keep the joints together to first order in h only: a knock changing the spin
+  //    w of a body by dw opens its joint by about h^2 |w| |dw| times the arm in the drift), and the
+  //    knocks of one step are not those of the next: on generated-1023 (seed 7 below), of 24,442 pairs
+  //    with a normal impulse in a (sub)step, 12,489 had none in the one before. Carried on as curvature,
+  //    those corrections opened the joints of the next step instead. Measured with
+  //    `aloft_step_profile 1023 5000 1 swinging:SEED` (seeds 7, 1, 2, 3), Newton corrections after the
+  //    drift per step 2.96, 4.29, 0.86, 2.95 -> 1.99, 2.29, 0.83, 2.23 (docs/performance.md, "2026-12-02,
+  //    later"); with the difference term of the last step without contact impulses instead of none,
+  //    2.33, 3.79, 0.87, 2.87; with M_n only at the joints of the bodies in contact and of their children,
+  //    2.75, 4.32 (the corrections spread through the tree). On the shaken Steel Fish, whose contacts
+  //    last longer, it costs 3 % more corrections (2.157 -> 2.226 per step, median of 40 seeds). Each
+  //    body's new angular velocity is checked against the step-size rule as it is made (spins_ok), while
+  //    the body's data are at hand.
+  const bool predict = guess && work.older_step == work.impulse_step && work.impulse_step == h &&
+                       !work.impulse_after_contacts;
   const bool project = guess && !predict && work.impulse_step == h;
   const double warm = guess && work.impulse_step > 0 ? h / work.impulse_step : 0.0;
   std::vector<Vec6>& sum = work.kick_sum;
@@ -818,6 +833,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   std::swap(work.impulse, work.step_impulse);
   work.older_step = work.impulse_step;
   work.impulse_step = h;
+  work.impulse_after_contacts = contact_report.active > 0;
 
   // 3. Factor at the new pose (also used by the next step), from the rotation matrices and lever arms of
   //    the last drift pass, and in the same sweep:
