@@ -134,7 +134,8 @@ struct StepWorkspace {
   std::vector<Vec3> projection;  // joint impulses of the last step's second half kick (N s), at its end
   std::vector<Vec3> older_projection;  // and of the step before
   double impulse_step = 0;       // the step length (s) impulse and projection belong to
-  bool impulse_after_contacts = false;  // the step `impulse` is from applied contact impulses
+  bool impulse_after_contacts = false;  // the step `impulse` comes from applied contact impulses (the next
+                                        // guess leaves out its difference term; see kick_and_collide)
   double older_step = 0;         // and the one of older_projection
   std::vector<Mat3> rotation;    // rotation matrices of next.orientation (index 0: the fixed pose)
   std::vector<Vec3> child_arm;   // at next's pose: R_i joint_in_child[i] (handed to the solver's factor)
