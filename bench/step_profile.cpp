@@ -61,11 +61,12 @@ int main(int argc, char** argv) {
   const long steps = std::atol(argv[2]);
   const bool collisions = argc > 3 && std::atoi(argv[3]) != 0;
   const std::string start = argc > 4 ? argv[4] : "breeze";
-  const std::string start_from = start.substr(0, start.find(':'));
+  const std::size_t colon = start.find(':');
+  const std::string start_from = start.substr(0, colon);
   unsigned long seed = 7;  // bench::swinging_state's default
   bool seed_ok = true;
-  if (start.find(':') != std::string::npos) {
-    const std::string digits = start.substr(start.find(':') + 1);
+  if (colon != std::string::npos) {
+    const std::string digits = start.substr(colon + 1);
     char* end = nullptr;
     seed = std::strtoul(digits.c_str(), &end, 10);
     seed_ok = !digits.empty() && *end == '\0' && start_from == "swinging";

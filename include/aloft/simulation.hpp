@@ -59,7 +59,8 @@ struct CollisionStatistics {
 // Running totals of how the (sub)steps were taken since the simulation started: what they cost and why
 // some were rejected, for profiling (aloft_step_profile prints them per step). A rejected (sub)step counts
 // once, under the check that rejected it; the Newton corrections (one tree solve each) are counted by
-// the phase of the step they closed the joints in, and add up to Simulation::joint_iterations().
+// the phase of the step they closed the joints in. Simulation::rejected_substeps() is attempts - accepted,
+// and Simulation::joint_iterations() the sum of the three corrections' counts.
 struct StepStatistics {
   long long attempts = 0;  // (sub)steps tried
   long long accepted = 0;  // of those, taken

@@ -143,12 +143,10 @@ struct StepWorkspace {
   std::vector<Vec3> inverse_moments;  // 1 / principal moments (kg^-1 m^-2)
   double state_sum = 0;          // sum of the last accepted (sub)step's state entries (NaN check)
   long long subdivisions = 0;    // how many times a step was halved
-  long long rejected = 0;        // how many (sub)steps rattle() rejected
   int start_depth = 0;           // the subdivision depth a step starts at (advance_by)
   int deepest = 0;               // the deepest subdivision a substep of this step was taken at
   int settled_steps = 0;         // steps in a row that needed no subdivision deeper than start_depth
-  long long joint_iterations = 0;  // SHAKE corrections (tree solves) over all (sub)steps
-  StepStatistics statistics;       // see Simulation::step_statistics
+  StepStatistics statistics;       // see Simulation::step_statistics (also rejected_substeps, joint_iterations)
   // Why rattle() last returned false (counted in `statistics` by advance_by).
   enum class Outcome { kSpin, kContactTurn, kJoints, kContactMotion } outcome = Outcome::kSpin;
   std::array<bool, 3> spin_over{};  // for kSpin: which of the rule's measures (turn, anchor, drift) were over
@@ -219,9 +217,15 @@ State& Simulation::mutable_state() {
 
 long long Simulation::subdivisions() const { return work_->subdivisions; }
 
-long long Simulation::rejected_substeps() const { return work_->rejected; }
+long long Simulation::rejected_substeps() const {
+  const StepStatistics& s = work_->statistics;
+  return s.attempts - s.accepted;
+}
 
-long long Simulation::joint_iterations() const { return work_->joint_iterations; }
+long long Simulation::joint_iterations() const {
+  const StepStatistics& s = work_->statistics;
+  return s.joint_corrections + s.contact_pass_corrections + s.push_corrections;
+}
 
 const StepStatistics& Simulation::step_statistics() const { return work_->statistics; }
 
@@ -527,13 +531,13 @@ ALOFT_CPU_DISPATCH double Simulation::drift_pass(double h, bool first_of_step, b
 // One Newton correction of rattle()'s drift: the tree solve of the joint gaps in work.rows, whose result
 // each body adds, inside the solve's base-to-tip sweep, to its half-step velocity (kVelocity, with the
 // joint impulses added to the step's) or to its pseudo-velocity (kPseudo) before drifting again
-// (drift_body). Returns the largest joint gap after it (m, per coordinate; NaN stays NaN).
+// (drift_body). Returns the largest joint gap after it (m, per coordinate; NaN stays NaN). Its callers
+// count it, by the phase of the step, in StepStatistics.
 double Simulation::correct_and_drift(double h, DriftCorrection correction, bool with_pseudo) {
   StepWorkspace& work = *work_;
   const State& now = state_;
   State& next = work.next;
   double worst = 0;
-  ++work.joint_iterations;
   const auto correct_and_drift_body = [&](int i, const Vec6& du, const Vec3& impulse) __attribute__((always_inline)) {
     if (correction == DriftCorrection::kVelocity) {
       next.velocity[i] += du.head<3>();
@@ -894,7 +898,6 @@ bool Simulation::advance_by(double h, int depth) {
       work.deepest = std::max(work.deepest, depth);
       return true;
     }
-    ++work.rejected;
     using Outcome = StepWorkspace::Outcome;
     switch (work.outcome) {
       case Outcome::kSpin:

@@ -9,6 +9,7 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 #include "collision/broad_phase.hpp"
+#include "support/shaking.hpp"
 
 namespace aloft {
 namespace {
@@ -101,14 +102,6 @@ TEST(Detector, DeterministicOnTheSteelFishSwung) {
 // GJK's distance estimate, above the truth where GJK stopped at its iteration limit on a wire lying along
 // a plate, was remembered as a lower bound. Checked every 20 ms along 10 s, as this test did then, that
 // went unseen; at every step it fails within the first 60 s.)
-// The shaking of the shaken Steel Fish test: every 50 steps (from step 0) a new uniform acceleration of
-// the whole mobile, 0.5 g rms per axis, drawn from g with rng, as if the hook were jerked about.
-void shake(const Model& m, Simulation& sim, std::mt19937& rng, std::normal_distribution<double>& g, int step) {
-  if (step % 50 != 0) return;
-  const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));
-  for (int i = 1; i < m.count; ++i) sim.loads().force[i] = m.mass[i] * jerk;
-}
-
 TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
   const Model m = load_mobile(std::string(ALOFT_SOURCE_DIR) + "/mobiles/steel-fish.json");
   Simulation sim(m);
@@ -124,7 +117,7 @@ TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
 #endif
   int with_contacts = 0;
   for (int step = 0; step < steps; ++step) {
-    shake(m, sim, rng, g, step);
+    test::shake(m, sim, rng, g, step);
     ASSERT_TRUE(sim.step()) << sim.failure()->message;
     steady.find_contacts(sim.state(), 0.001, 5e-4, remembered);
     forgetful.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
@@ -160,7 +153,7 @@ TEST(Detector, KeepingWithinANarrowerMarginGivesWhatALookWithItFinds) {
 #endif
   int with_contacts = 0, dropped = 0;
   for (int step = 0; step < steps; ++step) {
-    shake(m, sim, rng, g, step);
+    test::shake(m, sim, rng, g, step);
     ASSERT_TRUE(sim.step()) << sim.failure()->message;
     State slower = sim.state();
     for (int i = 0; i < m.count; ++i) slower.velocity[i] *= 0.9, slower.angular[i] *= 0.9;
@@ -215,7 +208,7 @@ TEST(Detector, LookingAgainAtTheFasterComponentsGivesWhatALookAtAllFinds) {
 #endif
   int with_contacts = 0, looked_again = 0;
   for (int step = 0; step < steps; ++step) {
-    shake(m, sim, rng, g, step);
+    test::shake(m, sim, rng, g, step);
     ASSERT_TRUE(sim.step()) << sim.failure()->message;
     State knocked = sim.state();
     for (int i = 1; i < m.count; ++i) {

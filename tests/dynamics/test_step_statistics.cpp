@@ -9,14 +9,15 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 #include "support/presets.hpp"
+#include "support/shaking.hpp"
 
 namespace aloft {
 namespace {
 
 // The invariants that hold after any run: every try is taken or rejected once, under one cause; every
 // step's substeps are the leaves of its halvings (a step halved k times takes k + 1 substeps); the
-// corrections by phase are all the Newton corrections; a spin rejection has at least one measure over
-// its limit.
+// corrections by phase are all the Newton corrections (rejected_substeps() and joint_iterations() are
+// derived from these totals); a spin rejection has at least one measure over its limit.
 void expect_totals_add_up(const Simulation& sim, long long steps) {
   const StepStatistics& s = sim.step_statistics();
   EXPECT_EQ(s.attempts, s.accepted + sim.rejected_substeps());
@@ -56,12 +57,10 @@ TEST(StepStatistics, TheShakenSteelFishCountsItsRejectionsAndContactWork) {
   // and spin, so that steps are halved and contacts are solved again after the joints' impulses.
   std::mt19937 rng(7);
   std::normal_distribution<double> g;
-  constexpr int kBursts = 400;  // of 50 ms
-  long long steps = 0;
-  for (int burst = 0; burst < kBursts; ++burst) {
-    const Vec3 jerk = 0.5 * 9.81 * Vec3(g(rng), g(rng), g(rng));
-    for (int i = 1; i < model.count; ++i) sim.loads().force[i] = model.mass[i] * jerk;
-    for (int step = 0; step < 50; ++step, ++steps) ASSERT_TRUE(sim.step()) << sim.failure()->message;
+  const long long steps = 20000;
+  for (int step = 0; step < steps; ++step) {
+    test::shake(model, sim, rng, g, step);
+    ASSERT_TRUE(sim.step()) << sim.failure()->message;
   }
   expect_totals_add_up(sim, steps);
   const StepStatistics& s = sim.step_statistics();
