@@ -287,8 +287,9 @@ TEST(ContactLaw, DependentContactsMeetTheLaw) {
       Eigen::VectorXd P;
       const ContactLawResult r = solve_contact_law(K, u, std::vector<ContactLawRow>(4, ContactLawRow{0.0, mu}), P);
       dropped += r.friction_dropped;
-      // A landing that does not converge is in a cycle; the forecast (contact_law.cpp) sees it within a
-      // window of 30 sweeps and a few more (31-37 here), instead of running to the 400-sweep cap.
+      // A landing whose sweeps do not converge (the corners trading sticking for sliding, above) is seen
+      // by the forecast (contact_law.cpp) within its window of 30 sweeps and a few more (31-37 here),
+      // instead of running to the 400-sweep cap.
       if (r.friction_dropped) {
         EXPECT_LE(r.iterations, 60) << "mu " << mu << " trial " << trial;
       }
