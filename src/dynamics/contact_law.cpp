@@ -311,8 +311,8 @@ bool exact_on_active_set(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n
 // solve where it meets the law within kExactResidual, and otherwise kNormalSweepsBetweenExact sweeps
 // from it to settle which contacts push. Where none held (contacts so dependent that the solve on the
 // active set gives impulses of both signs), the sweeps go on from where the first exact solve started,
-// up to kMaxNormalSweeps in all, as they would have without the exact solves; and the closest to the
-// law of all the impulses tried is kept.
+// up to kMaxNormalSweeps in all, as they would have without the exact solves. Whenever the solve ends
+// other than by an exact solve that held, the impulses closest to the law of all those tried are kept.
 void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,
                       Eigen::VectorXd& P_n) {
   const int m = static_cast<int>(u_n.size());
@@ -345,8 +345,8 @@ void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, c
     const bool settled =
         normal_sweeps(K_nn, target, velocity_scale, kNormalSweepsBetweenExact, between, tried, tried_velocity);
     keep_if_better(tried, tried_velocity);
-    if (settled) {
-      P_n = tried;
+    if (settled) {  // the sweeps converged from the candidate: the closest to the law seen is the result
+      P_n = best;
       return;
     }
   }
