@@ -3,16 +3,18 @@
 // velocities u before the impulse, find impulses P such that, with u' = u + K P,
 //   normal:   u'_n >= target_n,  P_n >= 0,  P_n (u'_n - target_n) = 0   (no pull, no overlap)
 //   friction: sticking  u'_t = 0 with |P_t| <= mu P_n,
-//             or sliding P_t = -mu P_n s on the edge of the Coulomb cone against the slip direction s.
+//             or sliding P_t = -mu P_n s on the edge of the Coulomb cone against the slip s = u'_t / |u'_t|
+//             the impulse leaves (so sliding starts, continuously, where sticking ends).
 // Each contact is expressed in its own orthonormal basis (n, t1, t2): 3 rows per contact, normal first.
 // K = G H^-1 G^T is the inverse effective mass seen at the contacts through the whole articulated tree
 // (symmetric positive semi-definite, 3m x 3m); u and P are in the same contact bases.
 //
 // The solve is block Gauss-Seidel over the contacts. For one contact it is exact in one pass: Mirtich's
 // prediction decides sticking or sliding from the 3x3 block K_kk before committing (the impulse that
-// would stick is computed; if it lies outside the cone the contact slides, and the normal impulse is
-// solved with the friction direction fixed), so the system is solved once, not once per guess. Several
-// simultaneous contacts are iterated until their impulses stop changing.
+// would stick is computed; if it lies outside the cone the contact slides, and the sliding impulse is
+// solved for, one equation in the angle of its friction), so the system is solved once, not once per
+// guess. Several simultaneous contacts are iterated until their impulses stop changing, with Newton's
+// method on the slowest of them now and then (contact_law.cpp, polish_law).
 
 #include <Eigen/Dense>
 
