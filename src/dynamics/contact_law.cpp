@@ -159,8 +159,9 @@ bool acceptable(const SlipAlong& at) { return at.valid && at.p > 0 && at.along >
 
 // The sliding impulse's direction e (see SlipAlong), by Newton's method on the angle from `start` (a unit
 // vector; from the last sweep's direction it takes 2-3 steps), or, where that finds no root with the slip
-// along e, the root nearest `start` of a scan of the circle in kSlipScan steps, each bracket refined by Newton's
-// method kept inside it (about 0.5 % of the sliding solves in the 1023 span from the swinging state).
+// along e, the root nearest `start` of a scan of the circle in kSlipScan steps, each bracket refined by
+// Newton's method kept inside it (about 0.5 % of the sliding solves in the 1023 span from the swinging
+// state).
 // False when no direction fits.
 constexpr int kSlipScan = 32;
 constexpr int kSlipNewtonIterations = 12;
@@ -279,16 +280,16 @@ Vec3d contact_impulse(const Mat3d& K, const BlockSolver& block, const Vec3d& u_f
 // the target and its friction is mu P_n against the slip after the impulse, P_t + mu P_n s = 0 with s =
 // u'_t / |u'_t|; one with a normal impulse alone meets the target with P_t = 0. The Jacobian is factored
 // once (rank-revealing: the contacts' rows are often dependent) and kept for up to kPolishIterations steps
-// (a chord method). `velocity` is u + K P. Gives the result in
-// P (false where no contact is in the cluster or the result is not finite); whether it meets the law is
-// for the sweep after it to tell. Why: the sweeps that do not converge within a few tens each had a
-// cluster of a few strongly coupled contacts converging slowly (Gauss-Seidel's error falling by 0.94 per
-// sweep, say) while the rest had settled; Newton's method on that cluster alone ends it. Measured on
-// the same inputs, 4960 solves written out from aloft_step_profile 1023 5000 1 swinging (every second
-// one; docs/performance.md, "2026-12-03, later"): falling back to the frictionless law, 981 with the old
-// law (friction against the slip before the impulse, no Newton), 836 with this law and no Newton, 422
-// with it (12.3 sweeps per solve against 34.5), and 389 for Newton on every contact that pushes, at 2.1
-// times the CPU time of this cluster's (1.42 times the old law's).
+// (a chord method). `velocity` is u + K P. Gives the result in P (false where no contact is in the
+// cluster or the result is not finite); whether it meets the law is for the sweep after it to tell.
+// Why: the sweeps that do not converge within a few tens each had a cluster of a few strongly coupled
+// contacts converging slowly (Gauss-Seidel's change falling by 0.94 per sweep, say) while the rest had
+// settled; Newton's method on that cluster alone ends it. Measured on the same inputs, 4960 solves
+// written out from the span of aloft_step_profile 1023 5000 1 swinging (every second one;
+// docs/performance.md, "2026-12-03, later"): falling back to the frictionless law, 981 with the old law
+// (friction against the slip before the impulse, no Newton), 836 with this law and no Newton, 422 with
+// it (12.3 sweeps per solve against 34.5), and 389 for Newton on every contact that pushes, at 2.1 times
+// the CPU time of this cluster's (1.42 times the old law's).
 constexpr int kPolishFirstSweep = 8;
 constexpr int kPolishEvery = 4;  // sweeps between polishes
 constexpr int kMaxPolishes = 6;
