@@ -161,8 +161,7 @@ bool acceptable(const SlipAlong& at) { return at.valid && at.p > 0 && at.along >
 // vector; from the last sweep's direction it takes 2-3 steps), or, where that finds no root with the slip
 // along e, the root nearest `start` of a scan of the circle in kSlipScan steps, each bracket refined by
 // Newton's method kept inside it (about 0.5 % of the sliding solves in the 1023 span from the swinging
-// state).
-// False when no direction fits.
+// state). False when no direction fits.
 constexpr int kSlipScan = 32;
 constexpr int kSlipNewtonIterations = 12;
 constexpr double kSlipAngleTolerance = 1e-14;  // rad: a Newton step below this ends the iteration
@@ -205,7 +204,8 @@ bool sliding_direction(const Mat3d& K, const Vec3d& u_free, double target, doubl
         } else {
           high = root;
         }
-        const double newton = there.slope != 0 ? root - there.g / there.slope : low - 1.0;
+        // Not finite where the slope is zero: then it fails the bracket test and the step bisects.
+        const double newton = root - there.g / there.slope;
         const double step = std::abs(newton - root);
         root = newton > low && newton < high ? newton : 0.5 * (low + high);
         if (step <= kSlipAngleTolerance) break;
