@@ -128,10 +128,14 @@ int main(int argc, char** argv) {
                 per_step(&StepStatistics::spin_anchor_over), per_step(&StepStatistics::spin_drift_over),
                 per_step(&StepStatistics::rejected_contact_turn), per_step(&StepStatistics::rejected_joints),
                 per_step(&StepStatistics::rejected_contact_motion));
+    const double sparse = per_step(&StepStatistics::sparse_corrections);
     std::printf("  per step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
-                "pushes; %.3f contact passes, %.3f pushes, %.3f friction dropped\n",
+                "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes, %.3f pushes, "
+                "%.3f friction dropped\n",
                 per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
-                per_step(&StepStatistics::push_corrections), per_step(&StepStatistics::contact_passes),
+                per_step(&StepStatistics::push_corrections), sparse,
+                sparse > 0 ? per_step(&StepStatistics::sparse_bodies) / sparse : 0.0,
+                per_step(&StepStatistics::contact_passes),
                 per_step(&StepStatistics::pushes),
                 static_cast<double>(sim.collision_statistics().friction_dropped - friction_dropped_before) / steps);
   } catch (const std::exception& e) {

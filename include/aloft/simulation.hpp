@@ -76,6 +76,9 @@ struct StepStatistics {
   // Newton corrections closing the joints after the step's first drift, after a contact pass, and under
   // the overlap push (of the pseudo-velocity).
   long long joint_corrections = 0, contact_pass_corrections = 0, push_corrections = 0;
+  // Of all those corrections, the sparse ones (after a pass that left few joints open: only the bodies
+  // they move are visited), and the bodies they visited in all.
+  long long sparse_corrections = 0, sparse_bodies = 0;
   long long contact_passes = 0;  // contacts solved again after the joints' impulses made them approach
   long long pushes = 0;          // (sub)steps that pushed overlapping pieces apart
 };
@@ -119,6 +122,11 @@ class Simulation {
   // it for every h instead (for studies of its effect); 0 restores the default.
   double joint_tolerance(double h) const;
   void set_joint_tolerance(double metres) { fixed_joint_tolerance_ = metres; }
+  // Whether a Newton correction that follows a pass leaving few joints open solves for those joints
+  // alone and visits only the bodies it moves (on by default; simulation.cpp, kSparseRowsPer). Off, every
+  // correction is a full solve: for tests and measurements. Mobiles of fewer than 64 bodies, or whose
+  // bodies are not in depth-first order, always take full corrections.
+  void set_sparse_corrections(bool on);
 
   // Air damping rates (1/s); default from the model.
   void set_damping(const DampingSpec& damping) { damping_ = damping; }

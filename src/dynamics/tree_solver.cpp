@@ -31,6 +31,20 @@ TreeSolver::TreeSolver(const Model& model)
     inverse_moments_[i] = model.principal_moments[i].cwiseInverse();
   }
   path_.reserve(n_);  // solve_sparse: at most every body (nothing allocates after construction)
+  // Subtree ranges, if the bodies are in depth-first preorder: every body lies within its parent's range
+  // and its own range within it (then each range holds exactly its subtree).
+  std::vector<int> size(n_, 1);
+  for (int i = n_ - 1; i >= 1; --i)
+    if (model.parent[i] > 0) size[model.parent[i]] += size[i];
+  bool preorder = true;
+  for (int i = 1; i < n_ && preorder; ++i) {
+    const int p = model.parent[i];
+    preorder = p == 0 || (p < i && i + size[i] <= p + size[p]);
+  }
+  if (preorder) {
+    subtree_end_.resize(n_);
+    for (int i = 0; i < n_; ++i) subtree_end_[i] = i + size[i];
+  }
   set_stack_folding(n_ >= kStackFoldingBodies);
 }
 

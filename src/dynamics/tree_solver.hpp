@@ -29,6 +29,7 @@
 // Newton corrections and the joint tolerance need.
 // The arrays are sized once; nothing allocates after construction.
 
+#include <algorithm>
 #include <vector>
 
 
@@ -135,6 +136,21 @@ class TreeSolver {
     substitute(visit);
   }
 
+  // solve_rows_visiting() for joint rows that are zero except at the joints `listed` (each joint once;
+  // joint i is body i's), visiting only the bodies the solve moves noticeably: the rest of the step's
+  // Newton corrections, after the first has closed all but a few joints. The tip-to-base sweep runs
+  // only along the listed joints' paths to the base (elsewhere g = 0, so y and the joint term are 0).
+  // The base-to-tip sweep goes as solve_rows_visiting()'s, except at a body off those paths whose parent
+  // moves its joint point by the velocity `parent_point` (the parent's u at the joint, world): if
+  // skip(i, parent_point) says that is negligible, body i's whole subtree is left as it was (taken as
+  // u = 0: its joints keep their gaps) and boundary(i) is called instead of visit (joint i is the one
+  // the parent's motion changes). Needs the bodies in depth-first preorder, so that a subtree is a range
+  // of indices (sparse_rows_possible()).
+  bool sparse_rows_possible() const { return !subtree_end_.empty(); }
+  template <class Skip, class Visit, class Boundary>
+  void solve_listed_rows_visiting(const std::vector<Vec3>& c, const std::vector<int>& listed, Skip&& skip,
+                                  Visit&& visit, Boundary&& boundary);
+
   // Eliminate three wrench columns (world; rows force then torque) applied at `body_a` (wrench_a) and
   // `body_b` (wrench_b) along the paths to the base, with the last factorization. Either body may be 0
   // (the fixed component: its wrench is ignored) and they may be equal. O(path lengths), no allocation once
@@ -229,9 +245,57 @@ class TreeSolver {
   std::vector<Vec6> y_;             // solve scratch: (c_i, e_i = C'^-1 h_i), h_i = g's torque about the joint point
   std::vector<Vec3> a_;             // solve scratch: joint terms, a_i = K^-1 c_i + P h_i - g_i's force
   std::vector<Vec6> u_;             // solve scratch: the solution (u_[0] = 0: the fixed component)
-  std::vector<char> on_path_;       // solve_sparse scratch: body i is on a listed body's path (0 between solves)
+  std::vector<char> on_path_;       // solve_sparse scratch: body i is on a listed body's path (0 between
+                                    // solves; solve_listed_rows_visiting: 2 for the listed joints themselves)
   std::vector<int> path_;           // solve_sparse scratch: those bodies
+  std::vector<int> subtree_end_;    // one past the last index of body i's subtree (bodies in depth-first
+                                    // preorder); empty when the order is not that
 };
+
+template <class Skip, class Visit, class Boundary>
+void TreeSolver::solve_listed_rows_visiting(const std::vector<Vec3>& c, const std::vector<int>& listed, Skip&& skip,
+                                            Visit&& visit, Boundary&& boundary) {
+  const std::vector<int>& parent = model_.parent;
+  for (const int b : listed) {
+    if (!on_path_[b]) path_.push_back(b);
+    on_path_[b] = 2;
+    for (int i = parent[b]; i > 0 && !on_path_[i]; i = parent[i]) {
+      on_path_[i] = 1;
+      path_.push_back(i);
+    }
+  }
+  std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
+  for (const int i : path_) {  // eliminate<false> along the paths, c = 0 at the joints not listed
+    const Vec6 g = g_[i];
+    g_[i].setZero();
+    eliminate_body(i, g, on_path_[i] == 2 ? c[i] : Vec3::Zero());
+  }
+  for (int i = 1; i < n_;) {
+    const int p = parent[i];
+    const bool given = on_path_[i] != 0;
+    Vec3 joint_velocity = given ? Vec3(y_[i].head<3>()) : Vec3::Zero();
+    Vec3 lam = given ? a_[i] : Vec3::Zero();
+    const Vec3 turn = given ? Vec3(y_[i].tail<3>()) : Vec3::Zero();
+    // (p was visited: a skipped body's subtree is passed over whole, and the fixed component does not move.)
+    const Vec3 parent_point_velocity =
+        p != 0 ? Vec3(u_[p].head<3>() + u_[p].tail<3>().cross(parent_arm_[i])) : Vec3::Zero();
+    if (!given && skip(i, parent_point_velocity)) {
+      boundary(i);
+      i = subtree_end_[i];
+      continue;
+    }
+    joint_velocity += parent_point_velocity;
+    lam += k_inv_[i] * parent_point_velocity;
+    Vec6 u;
+    u.tail<3>() = turn - p_[i].transpose() * joint_velocity;
+    u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
+    u_[i] = u;
+    visit(i, u, lam);
+    ++i;
+  }
+  for (const int i : path_) on_path_[i] = 0;
+  path_.clear();
+}
 
 // The symmetric KKT matrix H = [M J^T; J 0] written out densely (moving bodies 1..n-1 as 6-blocks, then
 // joints as 3-blocks), for tests: H [u; -lambda] = [f; c] is the system TreeSolver solves.

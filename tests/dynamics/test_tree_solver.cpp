@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <random>
 
@@ -309,6 +311,135 @@ TEST(TreeSolver, SparseSolveOfAFewWrenchesEqualsTheFullSolve) {
       for (int i = 0; i < model.count; ++i) EXPECT_EQ(sparse[i], full[i]) << "trial " << trial << ", body " << i;
     }
   }
+}
+
+TEST(TreeSolver, ListedRowsSolveVisitsWhatTheFullSolveMovesAndSkipsOnlyWhatItSaysIsStill) {
+  // Joint rows on a few joints of a generated mobile at a random pose (preorder, as compile() orders
+  // bodies). solve_listed_rows_visiting() must give every body it visits what the full solve of the same
+  // rows gives (number for number: the same operations along the paths, exact zeros elsewhere); pass over
+  // exactly the subtrees below the bodies it asked skip() about and was told to skip, calling boundary()
+  // for each such body once; and ask skip() only off the listed joints' paths.
+  GenerateOptions options;
+  options.components = 127;
+  options.seed = 4;
+  std::srand(29);
+  const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-127.json"));
+  State state = rest_state(model);
+  for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
+  TreeSolver solver(model);
+  ASSERT_TRUE(solver.sparse_rows_possible());
+  solver.factor(state);
+  std::mt19937 rng(31);
+  std::normal_distribution<double> normal;
+  std::uniform_int_distribution<int> joint(1, model.count - 1);
+  // Which bodies lie on a listed joint's path to the base.
+  const auto on_paths = [&](const std::vector<int>& listed) {
+    std::vector<char> on(model.count, 0);
+    for (int b : listed)
+      for (int i = b; i > 0; i = model.parent[i]) on[i] = 1;
+    return on;
+  };
+  int skipped_somewhere = 0, visited_off_paths = 0;  // (that the cases above were met at all)
+  for (int trial = 0; trial < 12; ++trial) {
+    std::vector<int> listed;
+    for (int k = 0; k < 1 + trial % 4; ++k) {
+      const int j = joint(rng);
+      if (std::find(listed.begin(), listed.end(), j) == listed.end()) listed.push_back(j);
+    }
+    std::vector<Vec3> rows(model.count, Vec3::Zero());
+    for (int j : listed)
+      for (int k = 0; k < 3; ++k) rows[j](k) = normal(rng);
+    std::vector<Vec6> full(model.count, Vec6::Zero());
+    std::vector<Vec3> full_lambda(model.count, Vec3::Zero());
+    solver.solve(std::vector<Vec6>(model.count, Vec6::Zero()), rows, full, &full_lambda);
+    // Rows that are not listed are ignored: garbage there must not change anything.
+    std::vector<Vec3> given = rows;
+    for (int i = 1; i < model.count; ++i)
+      if (std::find(listed.begin(), listed.end(), i) == listed.end()) given[i] = Vec3::Constant(1e6);
+    // Skip below a threshold that leaves some subtrees out (trial 0: skip nothing that moves at all).
+    const double threshold = trial == 0 ? 0.0 : 1e-3 * trial;
+    const std::vector<char> on = on_paths(listed);
+    std::vector<int> visited(model.count, 0), bounded(model.count, 0), asked(model.count, 0);
+    std::vector<Vec6> sparse(model.count, Vec6::Constant(NAN));
+    std::vector<Vec3> sparse_lambda(model.count, Vec3::Constant(NAN));
+    solver.solve_listed_rows_visiting(
+        given, listed,
+        [&](int i, const Vec3& parent_point) {
+          ++asked[i];
+          EXPECT_FALSE(on[i]) << "asked about body " << i << " on a listed joint's path";
+          // The parent's velocity at the joint point, as the full solve has it.
+          const int p = model.parent[i];
+          const Vec3 expected = p == 0 ? Vec3::Zero()
+                                       : Vec3(full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i]));
+          EXPECT_EQ(parent_point, expected) << "body " << i;
+          return parent_point.cwiseAbs().maxCoeff() <= threshold;
+        },
+        [&](int i, const Vec6& u, const Vec3& lambda) {
+          ++visited[i];
+          sparse[i] = u;
+          sparse_lambda[i] = lambda;
+        },
+        [&](int i) { ++bounded[i]; });
+    for (int i = 1; i < model.count; ++i) {
+      const int p = model.parent[i];
+      // A body is passed over when an ancestor (or itself) was skipped; it is visited otherwise.
+      const bool parent_passed = p > 0 && !visited[p];
+      if (parent_passed) {
+        EXPECT_EQ(visited[i] + bounded[i] + asked[i], 0) << "body " << i << " below a skipped body";
+        continue;
+      }
+      EXPECT_EQ(visited[i] + bounded[i], 1) << "body " << i;
+      if (visited[i]) {
+        EXPECT_EQ(sparse[i], full[i]) << "trial " << trial << ", body " << i;
+        EXPECT_EQ(sparse_lambda[i], full_lambda[i]) << "trial " << trial << ", body " << i;
+      } else {
+        // Skipped: the full solve moves it by no more than the threshold allowed at its joint point.
+        const Vec3 parent_point =
+            p == 0 ? Vec3::Zero() : Vec3(full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i]));
+        EXPECT_LE(parent_point.cwiseAbs().maxCoeff(), threshold) << "body " << i;
+      }
+    }
+    for (int j : listed) EXPECT_EQ(visited[j], 1) << "listed joint " << j;
+    for (int i = 1; i < model.count; ++i) {
+      skipped_somewhere += bounded[i] && !(full[i] == Vec6::Zero());
+      visited_off_paths += visited[i] && !on[i];
+    }
+    if (trial == 0) {  // nothing moving was skipped: only bodies whose joint point stays exactly still
+      for (int i = 1; i < model.count; ++i) {
+        if (bounded[i]) {
+          EXPECT_EQ(full[i], Vec6::Zero()) << "body " << i;
+        }
+      }
+    }
+  }
+  EXPECT_GT(skipped_somewhere, 0);
+  EXPECT_GT(visited_off_paths, 0);
+  std::printf("listed rows: %d bodies that move skipped, %d visited off the paths, over the trials\n",
+              skipped_somewhere, visited_off_paths);
+  // The solver is left ready for a plain solve.
+  std::vector<Vec3> rows(model.count, Vec3::Zero());
+  rows[5] = Vec3(1, 2, 3);
+  std::vector<Vec6> once(model.count, Vec6::Zero()), again(model.count, Vec6::Zero());
+  const std::vector<Vec6> no_wrench(model.count, Vec6::Zero());
+  solver.solve(no_wrench, rows, once);
+  solver.solve_listed_rows_visiting(rows, {5}, [](int, const Vec3&) { return false; },
+                                    [](int, const Vec6&, const Vec3&) {}, [](int) {});
+  solver.solve(no_wrench, rows, again);
+  for (int i = 0; i < model.count; ++i) EXPECT_EQ(once[i], again[i]) << "body " << i;
+}
+
+TEST(TreeSolver, ListedRowsNeedDepthFirstOrder) {
+  // Numbered breadth first (1 -> 2, 3; 2 -> 4; 3 -> 5), body 2's subtree {2, 4} is not a range of
+  // indices, so the sparse sweep, which passes over subtrees as ranges, is not offered; numbered depth
+  // first (1 -> 2 -> 3, 1 -> 4 -> 5) it is.
+  std::srand(11);
+  Model model = test::random_tree(6, 11);
+  model.parent = {-1, 0, 1, 1, 2, 3};
+  test::finish_model(model);
+  EXPECT_FALSE(TreeSolver(model).sparse_rows_possible());
+  model.parent = {-1, 0, 1, 2, 1, 4};
+  test::finish_model(model);
+  EXPECT_TRUE(TreeSolver(model).sparse_rows_possible());
 }
 
 }  // namespace
