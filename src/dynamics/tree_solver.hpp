@@ -206,12 +206,18 @@ class TreeSolver {
         joint_velocity += parent_point_velocity;
         lam += k_inv_[i] * parent_point_velocity;
       }
-      Vec6 u;
-      u.tail<3>() = turn - p_[i].transpose() * joint_velocity;
-      u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
+      const Vec6 u = body_velocity(i, joint_velocity, turn);
       u_[i] = u;
       visit(i, u, lam);
     }
+  }
+  // Body i's u = (v_i, w_i) from its joint point's velocity v_j and its turn e_i with the joint point
+  // held: w_i = e_i - P_i^T v_j, v_i = v_j - w_i x r_i (substitute's last step).
+  [[gnu::always_inline]] Vec6 body_velocity(int i, const Vec3& joint_velocity, const Vec3& turn) const {
+    Vec6 u;
+    u.tail<3>() = turn - p_[i].transpose() * joint_velocity;
+    u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
+    return u;
   }
 
   const Model& model_;
@@ -286,9 +292,7 @@ void TreeSolver::solve_listed_rows_visiting(const std::vector<Vec3>& c, const st
     }
     joint_velocity += parent_point_velocity;
     lam += k_inv_[i] * parent_point_velocity;
-    Vec6 u;
-    u.tail<3>() = turn - p_[i].transpose() * joint_velocity;
-    u.head<3>() = joint_velocity - u.tail<3>().cross(child_arm_[i]);
+    const Vec6 u = body_velocity(i, joint_velocity, turn);
     u_[i] = u;
     visit(i, u, lam);
     ++i;
