@@ -505,6 +505,19 @@ bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
 
 namespace {
 
+// Joint i's gap at body i's position and lever arm `child_arm` (world) and its parent's pose in work.next
+// (p < i: done first): the parent's lever arm into work.parent_arm[i], the gap divided by h into
+// work.rows[i], ready for the next solve. Returns the gap's largest coordinate (m; NaN stays NaN).
+[[gnu::always_inline]] inline double measure_joint(const Model& model, StepWorkspace& work, int i, double h,
+                                                   const Vec3& position, const Vec3& child_arm) {
+  const int p = model.parent[i];
+  const Vec3 parent_arm = work.rotation[p] * model.joint_in_parent[i];
+  const Vec3 gap = (work.next.position[p] + parent_arm) - (position + child_arm);
+  work.parent_arm[i] = parent_arm;
+  work.rows[i] = gap * (1.0 / h);
+  return gap.cwiseAbs().maxCoeff();
+}
+
 // The drift of body i from `now` into work.next (its parent's must be done): x' = x + h v,
 // q' = exp(h w_m) q with w_m = drift_map w (plus h times the pseudo-velocity if with_pseudo), the rotation
 // matrix and lever arms at the new pose (kept for the factorization), and the joint gap divided by h into
@@ -522,16 +535,11 @@ namespace {
   // matrix back stalls on store forwarding).
   const Mat3 turn = orientation.toRotationMatrix();
   const Vec3 child_arm = turn * model.joint_in_child[i];
-  const int p = model.parent[i];  // p < i: its rotation and position at the new pose are done
-  const Vec3 parent_arm = work.rotation[p] * model.joint_in_parent[i];
-  const Vec3 gap = (next.position[p] + parent_arm) - (position + child_arm);
   next.position[i] = position;
   next.orientation[i] = orientation;
   work.rotation[i] = turn;
   work.child_arm[i] = child_arm;
-  work.parent_arm[i] = parent_arm;
-  work.rows[i] = gap * (1.0 / h);
-  return gap.cwiseAbs().maxCoeff();
+  return measure_joint(model, work, i, h, position, child_arm);
 }
 
 // The larger of two gaps, NaN if either is (a NaN gap must not be lost).
@@ -629,14 +637,9 @@ double Simulation::correct_and_drift(double h, DriftCorrection correction, bool 
     return parent_point.cwiseAbs().maxCoeff() <= negligible;
   };
   const auto boundary = [&](int i) __attribute__((always_inline)) {
-    const int p = model_.parent[i];
-    const Vec3 parent_arm = work.rotation[p] * model_.joint_in_parent[i];
-    const Vec3 gap = (next.position[p] + parent_arm) - (next.position[i] + work.child_arm[i]);
-    work.parent_arm[i] = parent_arm;
-    work.rows[i] = gap * (1.0 / h);
-    const double widest_coordinate = gap.cwiseAbs().maxCoeff();
-    worst = widest(worst, widest_coordinate);
-    note_gap(work, i, widest_coordinate);
+    const double gap = measure_joint(model_, work, i, h, next.position[i], work.child_arm[i]);
+    worst = widest(worst, gap);
+    note_gap(work, i, gap);
   };
   const auto visit = [&](int i, const Vec6& du, const Vec3& impulse) __attribute__((always_inline)) {
     ++work.statistics.sparse_bodies;

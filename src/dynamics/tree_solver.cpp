@@ -144,7 +144,7 @@ void TreeSolver::solve(const std::vector<Vec6>& f, const std::vector<Vec3>& c, s
   }
 }
 
-void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>& bodies, std::vector<Vec6>& u) {
+void TreeSolver::mark_paths(const std::vector<int>& bodies) {
   const std::vector<int>& parent = model_.parent;
   for (int b : bodies)
     for (int i = b; i > 0 && !on_path_[i]; i = parent[i]) {
@@ -152,6 +152,10 @@ void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>
       path_.push_back(i);
     }
   std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
+}
+
+void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>& bodies, std::vector<Vec6>& u) {
+  mark_paths(bodies);
   for (const int i : path_) {  // eliminate<true> with c = 0
     const Vec6 g = g_[i] + f[i];
     g_[i].setZero();

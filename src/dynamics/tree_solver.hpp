@@ -211,6 +211,9 @@ class TreeSolver {
       visit(i, u, lam);
     }
   }
+  // Marks the bodies on the paths from `bodies` to the base (on_path_ = 1) and lists them in path_, tip to
+  // base (the sparse solves' tip-to-base sweep).
+  void mark_paths(const std::vector<int>& bodies);
   // Body i's u = (v_i, w_i) from its joint point's velocity v_j and its turn e_i with the joint point
   // held: w_i = e_i - P_i^T v_j, v_i = v_j - w_i x r_i (substitute's last step).
   [[gnu::always_inline]] Vec6 body_velocity(int i, const Vec3& joint_velocity, const Vec3& turn) const {
@@ -262,15 +265,8 @@ template <class Skip, class Visit, class Boundary>
 void TreeSolver::solve_listed_rows_visiting(const std::vector<Vec3>& c, const std::vector<int>& listed, Skip&& skip,
                                             Visit&& visit, Boundary&& boundary) {
   const std::vector<int>& parent = model_.parent;
-  for (const int b : listed) {
-    if (!on_path_[b]) path_.push_back(b);
-    on_path_[b] = 2;
-    for (int i = parent[b]; i > 0 && !on_path_[i]; i = parent[i]) {
-      on_path_[i] = 1;
-      path_.push_back(i);
-    }
-  }
-  std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
+  mark_paths(listed);
+  for (const int b : listed) on_path_[b] = 2;
   for (const int i : path_) {  // eliminate<false> along the paths, c = 0 at the joints not listed
     const Vec6 g = g_[i];
     g_[i].setZero();
