@@ -209,6 +209,68 @@ TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
   EXPECT_GT(sliding, 5);  // the sliding branch was exercised
 }
 
+// The contact pass (Simulation's step, after the joints' Newton corrections): when the joints' impulses
+// made the kept contacts approach again, correct() applies extra impulses. After it no contact
+// approaches, the joints still move together and no energy is added.
+TEST(ContactResponse, CorrectionStopsTheApproachKeepsTheJointsAndAddsNoEnergy) {
+  int corrected = 0;
+  for (unsigned seed = 1; seed <= 40; ++seed) {
+    std::srand(seed);
+    Model model = test::random_tree(12, seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    model.restitution.assign(model.count, 0.0);
+    model.friction.assign(model.count, 0.8 * unit(rng));
+    State state = rest_state(model);
+    TreeSolver solver(model);
+    solver.factor(state);
+    random_consistent_velocities(model, solver, seed + 3, state);
+    std::vector<Contact> contacts;
+    for (int k = 0; k < 2; ++k) {
+      int a = static_cast<int>(unit(rng) * model.count), b = static_cast<int>(unit(rng) * model.count);
+      if (a == b) b = (b + 1) % model.count;
+      if (a > b) std::swap(a, b);
+      contacts.push_back(approaching_contact(state, a, b, 0.1 * Vec3::Random(), Vec3::Random()));
+    }
+    ContactResponse response(model);
+    response.tuning.bounce_threshold = 0;
+    std::vector<Vec6> pseudo(model.count, Vec6::Zero());
+    bool has_pseudo = false;
+    response.resolve(state, solver, contacts, 1e-3, state.velocity, state.angular, pseudo, has_pseudo);
+    // What the joints' impulses do in the drift, for the test: another joint-consistent velocity on top.
+    State pushed = state;
+    random_consistent_velocities(model, solver, seed + 100, pushed);
+    for (int i = 1; i < model.count; ++i) {
+      pushed.velocity[i] = state.velocity[i] + 0.5 * pushed.velocity[i];
+      pushed.angular[i] = state.angular[i] + 0.5 * pushed.angular[i];
+    }
+    const double tolerance = 1e-6;  // m/s, the step's (kContactVelocityTolerance)
+    const double before = kinetic_energy(model, pushed);
+    if (!response.correct(1e-3, pushed.velocity, pushed.angular, tolerance)) continue;
+    ++corrected;
+    // Inelastic (e = 0) impulses only take energy out (round-off of O(1) energies allowed).
+    EXPECT_LE(kinetic_energy(model, pushed), before * (1 + 1e-10)) << "seed " << seed;
+    for (const Contact& c : response.kept()) {
+      const auto point_velocity = [&](int i) {
+        return i == 0 ? Vec3::Zero() : Vec3(pushed.velocity[i] + pushed.angular[i].cross(c.point - pushed.position[i]));
+      };
+      // n . (v_a - v_b) < 0 approaches; the contact law holds it to within its own accuracy (1e-9 of
+      // O(1) velocities) of no approach.
+      EXPECT_GE(c.normal.dot(point_velocity(c.a) - point_velocity(c.b)), -1e-9) << "seed " << seed;
+    }
+    for (int i = 1; i < model.count; ++i) {
+      const int p = model.parent[i];
+      const Vec3 r = state.orientation[i] * model.joint_in_child[i];
+      const Vec3 s = state.orientation[p] * model.joint_in_parent[i];
+      const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(pushed.velocity[p] + pushed.angular[p].cross(s));
+      EXPECT_LT((pushed.velocity[i] + pushed.angular[i].cross(r) - vp).norm(), 1e-9) << "seed " << seed;
+    }
+    // A second look finds nothing more to do.
+    EXPECT_FALSE(response.correct(1e-3, pushed.velocity, pushed.angular, tolerance)) << "seed " << seed;
+  }
+  EXPECT_GT(corrected, 10);
+}
+
 TEST(ContactResponse, OverlapIsPushedOutByAPseudoVelocityOnly) {
   const Model model = random_chain(4, 3);
   State state = rest_state(model);
