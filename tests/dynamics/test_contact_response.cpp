@@ -158,27 +158,45 @@ TEST(ContactResponse, TwoLinksOfOneChainMatchMooresDenseSystem) {
   EXPECT_GE(compared, 3);
 }
 
-TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
-  int sliding = 0;
-  for (unsigned seed = 1; seed <= 60; ++seed) {
-    std::srand(seed);
-    Model model = test::random_tree(12, seed);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    model.restitution.assign(model.count, unit(rng));
-    model.friction.assign(model.count, 1.2 * unit(rng));
-    State state = rest_state(model);
-    TreeSolver solver(model);
+// A random 12-body tree at rest pose with random joint-consistent velocities, factored, and `count`
+// simultaneous approaching contacts between random bodies (or against the hook). Restitution random in
+// [0, 1) per tree if random_restitution, else 0; friction random in [0, friction_scale).
+struct RandomContactCase {
+  RandomContactCase(unsigned seed, bool random_restitution, double friction_scale, int count)
+      : model(make_model(seed, random_restitution, friction_scale)), state(rest_state(model)), solver(model) {
     solver.factor(state);
     random_consistent_velocities(model, solver, seed + 3, state);
-    // Three simultaneous contacts between random bodies (or against the hook).
-    std::vector<Contact> contacts;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < count; ++k) {
       int a = static_cast<int>(unit(rng) * model.count), b = static_cast<int>(unit(rng) * model.count);
       if (a == b) b = (b + 1) % model.count;
       if (a > b) std::swap(a, b);
       contacts.push_back(approaching_contact(state, a, b, 0.1 * Vec3::Random(), Vec3::Random()));
     }
+  }
+  Model make_model(unsigned seed, bool random_restitution, double friction_scale) {
+    std::srand(seed);
+    Model m = test::random_tree(12, seed);
+    rng.seed(seed);
+    m.restitution.assign(m.count, random_restitution ? unit(rng) : 0.0);
+    m.friction.assign(m.count, friction_scale * unit(rng));
+    return m;
+  }
+  std::mt19937 rng;
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+  Model model;
+  State state;
+  TreeSolver solver;
+  std::vector<Contact> contacts;
+};
+
+TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
+  int sliding = 0;
+  for (unsigned seed = 1; seed <= 60; ++seed) {
+    RandomContactCase test_case(seed, true, 1.2, 3);
+    const Model& model = test_case.model;
+    const State& state = test_case.state;
+    TreeSolver& solver = test_case.solver;
+    const std::vector<Contact>& contacts = test_case.contacts;
     const double before = kinetic_energy(model, state);
     ContactResponse response(model);
     response.tuning.bounce_threshold = 0;
@@ -215,23 +233,11 @@ TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
 TEST(ContactResponse, CorrectionStopsTheApproachKeepsTheJointsAndAddsNoEnergy) {
   int corrected = 0;
   for (unsigned seed = 1; seed <= 40; ++seed) {
-    std::srand(seed);
-    Model model = test::random_tree(12, seed);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    model.restitution.assign(model.count, 0.0);
-    model.friction.assign(model.count, 0.8 * unit(rng));
-    State state = rest_state(model);
-    TreeSolver solver(model);
-    solver.factor(state);
-    random_consistent_velocities(model, solver, seed + 3, state);
-    std::vector<Contact> contacts;
-    for (int k = 0; k < 2; ++k) {
-      int a = static_cast<int>(unit(rng) * model.count), b = static_cast<int>(unit(rng) * model.count);
-      if (a == b) b = (b + 1) % model.count;
-      if (a > b) std::swap(a, b);
-      contacts.push_back(approaching_contact(state, a, b, 0.1 * Vec3::Random(), Vec3::Random()));
-    }
+    RandomContactCase test_case(seed, false, 0.8, 2);
+    const Model& model = test_case.model;
+    State& state = test_case.state;
+    TreeSolver& solver = test_case.solver;
+    const std::vector<Contact>& contacts = test_case.contacts;
     ContactResponse response(model);
     response.tuning.bounce_threshold = 0;
     std::vector<Vec6> pseudo(model.count, Vec6::Zero());
