@@ -100,6 +100,13 @@ class CollisionDetector {
   // closed the gap (on by default; detector.cpp, "Coherence"). It never changes the contacts found, only
   // the time taken: off is for checking that, and for measuring what it saves.
   void set_coherence(bool on);
+  // How the pair list of coherence was kept up to date so far (detector.cpp, "Coherence"): the calls
+  // that made it afresh, and those that looked again only at the pairs of the few components that had
+  // moved past their skins. (Diagnostics and tests; with coherence off every call makes it afresh.)
+  struct PairListCounts {
+    long long made = 0, relisted = 0;
+  };
+  PairListCounts pair_list_counts() const;
 
   // The signed distance (m, < 0 when they overlap: minus the depth) between the shapes of components a
   // and b placed at the given poses (centre of mass, orientation of the principal frame; world), exact

@@ -130,10 +130,14 @@ void BroadPhase::sweep_and_prune(std::vector<std::pair<int, int>>& overlaps) {
   std::sort(overlaps.begin(), overlaps.end());
 }
 
+bool BroadPhase::through_tree() const {
+  return order_.size() >= kTreeMembers && most_children_ <= kTreeMostChildren &&
+         roots_.size() <= static_cast<std::size_t>(kTreeMostChildren);
+}
+
 void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
   overlaps.clear();
-  if (order_.size() < kTreeMembers || most_children_ > kTreeMostChildren ||
-      roots_.size() > static_cast<std::size_t>(kTreeMostChildren)) {
+  if (!through_tree()) {
     sweep_and_prune(overlaps);
     return;
   }
@@ -158,6 +162,49 @@ void BroadPhase::sweep(std::vector<std::pair<int, int>>& overlaps) {
   for (std::size_t k = 0; k < roots_.size(); ++k)
     for (std::size_t l = k + 1; l < roots_.size(); ++l) collide(roots_[k], roots_[l], overlaps);
   std::sort(overlaps.begin(), overlaps.end());
+}
+
+void BroadPhase::query_everything(int a, std::vector<std::pair<int, int>>& overlaps) {
+  const WorldBox& box = boxes_[a];
+  query_stack_.clear();
+  for (const int root : roots_)
+    if (overlap(box, subtree_[root])) query_stack_.push_back(root);
+  while (!query_stack_.empty()) {
+    const int x = query_stack_.back();  // its subtree box overlaps a's box
+    query_stack_.pop_back();
+    if (member_[x] && x != a && parent_[x] != a && parent_[a] != x && overlap(box, boxes_[x])) emit(a, x, overlaps);
+    for (int k = child_begin_[x]; k < child_begin_[x + 1]; ++k)
+      if (overlap(box, subtree_[child_[k]])) query_stack_.push_back(child_[k]);
+  }
+}
+
+void BroadPhase::overlaps_of(const std::vector<int>& changed, std::vector<std::pair<int, int>>& overlaps) {
+  overlaps.clear();
+  if (through_tree()) {
+    // The subtree boxes made again, tight as sweep() makes them (each around its component's box and its
+    // children's subtree boxes), along the path from each changed component to its root, up to the first
+    // that comes out the same (its ancestors' are then right too: a changed ancestor's path is walked
+    // from that ancestor).
+    for (const int a : changed) {
+      for (int p = a; p >= 0; p = parent_[p]) {
+        WorldBox around = boxes_[p];
+        for (int k = child_begin_[p]; k < child_begin_[p + 1]; ++k) {
+          around.low = around.low.cwiseMin(subtree_[child_[k]].low);
+          around.high = around.high.cwiseMax(subtree_[child_[k]].high);
+        }
+        if (around.low == subtree_[p].low && around.high == subtree_[p].high) break;
+        subtree_[p] = around;
+      }
+    }
+    for (const int a : changed) query_everything(a, overlaps);
+  } else {
+    for (const int a : changed)
+      for (const int x : order_)
+        if (x != a && parent_[x] != a && parent_[a] != x && overlap(boxes_[a], boxes_[x])) emit(a, x, overlaps);
+  }
+  // Two changed components that overlap each other are found from both.
+  std::sort(overlaps.begin(), overlaps.end());
+  overlaps.erase(std::unique(overlaps.begin(), overlaps.end()), overlaps.end());
 }
 
 int widest_axis(const std::vector<Vec3>& points) {

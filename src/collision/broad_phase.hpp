@@ -51,8 +51,20 @@ class BroadPhase {
   // parent and its child (their boxes always overlap, and the joint is not a contact: on a generated
   // mobile, nearly all the overlaps). Replaces `overlaps`.
   void sweep(std::vector<std::pair<int, int>>& overlaps);
+  // After a sweep(), when only the boxes of `changed` (members, each once) have been set since (or were
+  // passed to an earlier overlaps_of): the pairs, as sweep() gives them (a < b, sorted, a parent and its
+  // child left out), of members whose boxes overlap one of `changed`'s. Replaces `overlaps`. Costs, per
+  // changed box, the subtree boxes on its path to the root made again and a look down the tree (with
+  // sweep and prune, a test against every member), instead of the whole mobile's sweep: how a pair list
+  // is kept up to date when a few components have moved.
+  void overlaps_of(const std::vector<int>& changed, std::vector<std::pair<int, int>>& overlaps);
 
  private:
+  // Whether sweep() goes through the tree (else sweep and prune); fixed by reset().
+  bool through_tree() const;
+  // Every member of the whole tree whose box overlaps member a's, paired with a (a itself, its parent
+  // and its children left out: joined).
+  void query_everything(int a, std::vector<std::pair<int, int>>& overlaps);
   // Every member of the subtree at `root` whose box overlaps `box`, paired with `a` (except root itself
   // when it is a's child: joined).
   void query(int a, const WorldBox& box, int root, std::vector<std::pair<int, int>>& overlaps);

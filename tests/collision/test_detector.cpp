@@ -6,6 +6,7 @@
 #include <random>
 
 #include "aloft/collision.hpp"
+#include "aloft/generate.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 #include "collision/broad_phase.hpp"
@@ -133,6 +134,48 @@ TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
   }
   std::printf("%d steps compared, %d with contacts\n", steps, with_contacts);
   EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
+}
+
+TEST(Detector, PairListKeptUpToDateGivesTheContactsOfAFreshDetectorOnALargeMobile) {
+  // The same comparison on the generated 1023-component mobile (its broad phase goes through the tree),
+  // knocking about in `aloft bench`'s breeze (0.2 g on every component) with collisions on: most calls
+  // find the pair list holding, some list again only the few components that moved past their skins
+  // (relist), some make it afresh. Every call's contacts must be those of a detector that keeps nothing.
+  GenerateOptions options;
+  options.components = 1023;
+  const Model m = compile(parse_mobile_text(generate_mobile(options), "generated-1023.json"));
+  Simulation sim(m);
+  for (int i = 1; i < m.count; ++i) {
+    const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
+    sim.loads().force[i] = 0.2 * 9.81 * m.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+  }
+  CollisionDetector steady(m), forgetful(m);
+  forgetful.set_coherence(false);
+  std::vector<Contact> remembered, fresh_contacts;
+#ifdef ALOFT_SANITIZED
+  const int steps = 300;  // the sanitizers are ten times slower
+#else
+  const int steps = 1500;
+#endif
+  int with_contacts = 0;
+  for (int step = 0; step < steps; ++step) {
+    ASSERT_TRUE(sim.step()) << sim.failure()->message;
+    steady.find_contacts(sim.state(), 0.001, 5e-4, remembered);
+    forgetful.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
+    with_contacts += !fresh_contacts.empty();
+    ASSERT_EQ(remembered.size(), fresh_contacts.size()) << "step " << step;
+    for (std::size_t k = 0; k < remembered.size(); ++k) {
+      ASSERT_EQ(remembered[k].a, fresh_contacts[k].a) << "step " << step;
+      ASSERT_EQ(remembered[k].b, fresh_contacts[k].b) << "step " << step;
+      ASSERT_EQ(remembered[k].distance, fresh_contacts[k].distance) << "step " << step;
+      ASSERT_EQ(remembered[k].point, fresh_contacts[k].point) << "step " << step;
+    }
+  }
+  const CollisionDetector::PairListCounts counts = steady.pair_list_counts();
+  std::printf("%d steps compared, %d with contacts; the pair list made %lld times, relisted %lld\n", steps,
+              with_contacts, counts.made, counts.relisted);
+  EXPECT_GT(with_contacts, steps / 10) << "the breeze should bring pieces within the margin";
+  EXPECT_GT(counts.relisted, steps / 20) << "the comparison should cover lists kept up to date in part";
 }
 
 TEST(Detector, KeepingWithinANarrowerMarginGivesWhatALookWithItFinds) {
@@ -308,6 +351,71 @@ TEST(BroadPhase, FindsExactlyThePairsThatATestOfEveryPairFinds) {
   }
   std::printf("%d trees, %lld overlapping pairs, all found\n", trees, pairs_seen);
   EXPECT_GT(pairs_seen, 10000);  // the boxes are dense enough for the comparison to mean something
+}
+
+TEST(BroadPhase, OverlapsOfChangedBoxesAreThoseATestOfEveryPairFinds) {
+  // As above (random trees, chains and stars, both ways of sweeping), then rounds of moving a random few
+  // of the boxes: overlaps_of() on those must give exactly the overlapping pairs that have one of them,
+  // as the all-pairs test finds them, whatever moved in the rounds before (the tree's subtree boxes are
+  // only grown between sweeps).
+  std::mt19937 rng(13);
+  std::uniform_int_distribution<int> grid(0, 40);
+  std::uniform_int_distribution<int> extent(0, 8);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  long long pairs_seen = 0;
+  int rounds = 0;
+  for (const int count : {2, 17, 100, 700, 2000}) {
+    for (const int shape : {0, 1, 2}) {  // random tree, chain, star
+      std::vector<int> parent(count, -1);
+      for (int i = 1; i < count; ++i)
+        parent[i] = shape == 0 ? static_cast<int>(unit(rng) * i) : shape == 1 ? i - 1 : 0;
+      std::vector<int> members;
+      for (int i = 0; i < count; ++i)
+        if (unit(rng) < 0.8) members.push_back(i);
+      if (members.empty()) continue;
+      internal::BroadPhase broad;
+      broad.reset(members, count, static_cast<int>(unit(rng) * 3), parent);
+      std::vector<internal::WorldBox> boxes(count);
+      const auto place = [&](int i) {
+        const Vec3 low(0.025 * grid(rng), 0.025 * grid(rng), 0.025 * grid(rng));
+        const Vec3 size(0.025 * extent(rng), 0.025 * extent(rng), 0.025 * extent(rng));
+        boxes[i] = {low, low + size};
+        broad.box(i) = boxes[i];
+      };
+      for (const int i : members) place(i);
+      std::vector<std::pair<int, int>> found;
+      broad.sweep(found);
+      std::vector<char> changed_flag(count, 0);
+      for (int round = 0; round < 5; ++round, ++rounds) {
+        // A few members moved (each at most once per round), up to a tenth of them.
+        std::vector<int> changed;
+        const int how_many = 1 + static_cast<int>(unit(rng) * (1 + members.size() / 10));
+        for (int k = 0; k < how_many; ++k) {
+          const int i = members[static_cast<std::size_t>(unit(rng) * members.size())];
+          if (changed_flag[i]) continue;
+          changed_flag[i] = 1;
+          changed.push_back(i);
+          place(i);
+        }
+        broad.overlaps_of(changed, found);
+        std::vector<std::pair<int, int>> expected;
+        for (std::size_t x = 0; x < members.size(); ++x) {
+          for (std::size_t y = x + 1; y < members.size(); ++y) {
+            const int a = members[x], b = members[y];  // a < b
+            if (parent[b] == a || !(changed_flag[a] || changed_flag[b])) continue;
+            const internal::WorldBox &p = boxes[a], &q = boxes[b];
+            if ((p.low.array() <= q.high.array()).all() && (q.low.array() <= p.high.array()).all())
+              expected.emplace_back(a, b);
+          }
+        }
+        ASSERT_EQ(found, expected) << count << " components, shape " << shape << ", round " << round;
+        pairs_seen += static_cast<long long>(expected.size());
+        for (const int i : changed) changed_flag[i] = 0;
+      }
+    }
+  }
+  std::printf("%d rounds, %lld overlapping pairs with a moved box, all found\n", rounds, pairs_seen);
+  EXPECT_GT(pairs_seen, 1000);  // the boxes are dense enough for the comparison to mean something
 }
 
 }  // namespace
