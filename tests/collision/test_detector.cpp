@@ -30,6 +30,21 @@ Model two_balls() {
   return compile(parse_mobile_text(text, "two.json"));
 }
 
+// Whether two looks gave the same contacts, bit for bit (pairs, distances, normals, points), in the same
+// order; the first difference otherwise.
+::testing::AssertionResult same_contacts(const std::vector<Contact>& x, const std::vector<Contact>& y) {
+  if (x.size() != y.size())
+    return ::testing::AssertionFailure() << x.size() << " contacts against " << y.size();
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (x[k].a != y[k].a || x[k].b != y[k].b || x[k].distance != y[k].distance || x[k].normal != y[k].normal ||
+        x[k].point != y[k].point)
+      return ::testing::AssertionFailure() << "contact " << k << ": pair (" << x[k].a << ", " << x[k].b
+                                           << ") at distance " << x[k].distance << " against pair (" << y[k].a
+                                           << ", " << y[k].b << ") at " << y[k].distance;
+  }
+  return ::testing::AssertionSuccess();
+}
+
 // Move `i` rigidly by `shift` (m).
 void shift(State& s, int i, const Vec3& d) { s.position[i] += d; }
 
@@ -123,14 +138,7 @@ TEST(Detector, RememberedDistancesGiveTheContactsOfAFreshDetector) {
     steady.find_contacts(sim.state(), 0.001, 5e-4, remembered);
     forgetful.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
     with_contacts += !fresh_contacts.empty();
-    ASSERT_EQ(remembered.size(), fresh_contacts.size()) << "step " << step;
-    for (std::size_t k = 0; k < remembered.size(); ++k) {
-      ASSERT_EQ(remembered[k].a, fresh_contacts[k].a) << "step " << step;
-      ASSERT_EQ(remembered[k].b, fresh_contacts[k].b) << "step " << step;
-      ASSERT_EQ(remembered[k].distance, fresh_contacts[k].distance) << "step " << step;
-      ASSERT_EQ(remembered[k].normal, fresh_contacts[k].normal) << "step " << step;
-      ASSERT_EQ(remembered[k].point, fresh_contacts[k].point) << "step " << step;
-    }
+    ASSERT_TRUE(same_contacts(remembered, fresh_contacts)) << "step " << step;
   }
   std::printf("%d steps compared, %d with contacts\n", steps, with_contacts);
   EXPECT_GT(with_contacts, steps / 100) << "the shaking should bring pieces within the margin";
@@ -163,13 +171,7 @@ TEST(Detector, PairListKeptUpToDateGivesTheContactsOfAFreshDetectorOnALargeMobil
     steady.find_contacts(sim.state(), 0.001, 5e-4, remembered);
     forgetful.find_contacts(sim.state(), 0.001, 5e-4, fresh_contacts);
     with_contacts += !fresh_contacts.empty();
-    ASSERT_EQ(remembered.size(), fresh_contacts.size()) << "step " << step;
-    for (std::size_t k = 0; k < remembered.size(); ++k) {
-      ASSERT_EQ(remembered[k].a, fresh_contacts[k].a) << "step " << step;
-      ASSERT_EQ(remembered[k].b, fresh_contacts[k].b) << "step " << step;
-      ASSERT_EQ(remembered[k].distance, fresh_contacts[k].distance) << "step " << step;
-      ASSERT_EQ(remembered[k].point, fresh_contacts[k].point) << "step " << step;
-    }
+    ASSERT_TRUE(same_contacts(remembered, fresh_contacts)) << "step " << step;
   }
   const CollisionDetector::PairListCounts counts = steady.pair_list_counts();
   std::printf("%d steps compared, %d with contacts; the pair list made %lld times, relisted %lld\n", steps,
