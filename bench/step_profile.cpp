@@ -17,7 +17,8 @@
 // Prints the thread CPU time per step and per moving component-step, the step halvings and tree solves
 // per step, and a checksum of the final state (equal on two runs of one build); then, per step, how the
 // (sub)steps went (Simulation::step_statistics): the tries and those taken, the rejections by their
-// cause, the Newton corrections by phase, the contact passes and overlap pushes, and, with collisions
+// cause, the Newton corrections by phase, the contact passes (and how many bodies the sparse ones drift)
+// and overlap pushes, and, with collisions
 // on, the (sub)steps whose contact law dropped friction (CollisionStatistics::friction_dropped).
 
 #include <time.h>
@@ -129,13 +130,15 @@ int main(int argc, char** argv) {
                 per_step(&StepStatistics::rejected_contact_turn), per_step(&StepStatistics::rejected_joints),
                 per_step(&StepStatistics::rejected_contact_motion));
     const double sparse = per_step(&StepStatistics::sparse_corrections);
+    const double sparse_passes = per_step(&StepStatistics::sparse_contact_passes);
     std::printf("  per step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
-                "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes, %.3f pushes, "
-                "%.3f friction dropped\n",
+                "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes (%.3f of them "
+                "sparse, drifting %.0f bodies each), %.3f pushes, %.3f friction dropped\n",
                 per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
                 per_step(&StepStatistics::push_corrections), sparse,
                 sparse > 0 ? per_step(&StepStatistics::sparse_bodies) / sparse : 0.0,
-                per_step(&StepStatistics::contact_passes),
+                per_step(&StepStatistics::contact_passes), sparse_passes,
+                sparse_passes > 0 ? per_step(&StepStatistics::sparse_contact_pass_bodies) / sparse_passes : 0.0,
                 per_step(&StepStatistics::pushes),
                 static_cast<double>(sim.collision_statistics().friction_dropped - friction_dropped_before) / steps);
   } catch (const std::exception& e) {

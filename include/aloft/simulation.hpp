@@ -80,6 +80,9 @@ struct StepStatistics {
   // they move are visited), and the bodies they visited in all.
   long long sparse_corrections = 0, sparse_bodies = 0;
   long long contact_passes = 0;  // contacts solved again after the joints' impulses made them approach
+  // Of those, the sparse ones (only the bodies their impulses move are drifted again), and the bodies
+  // they drifted in all.
+  long long sparse_contact_passes = 0, sparse_contact_pass_bodies = 0;
   long long pushes = 0;          // (sub)steps that pushed overlapping pieces apart
 };
 
@@ -163,6 +166,7 @@ class Simulation {
   enum class DriftCorrection { kVelocity, kPseudo };
   double drift_pass(double h, bool first_of_step, bool with_pseudo);
   double correct_and_drift(double h, DriftCorrection correction, bool with_pseudo);
+  double contact_pass_drift(double h);
   bool push_apart(double h);
   bool kick_and_collide(double h, bool guess, ContactStepReport& contact_report, bool& has_pseudo);
   bool at_finest_step(double h) const;

@@ -39,7 +39,7 @@ ContactResponse::ContactResponse(const Model& model)
       wrench_(model.count, Vec6::Zero()),
       du_(model.count, Vec6::Zero()) {}
 
-void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
+void ContactResponse::gather_wrenches(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
   const int m = static_cast<int>(contacts.size());
   for (int k = 0; k < m; ++k) {
     const Vec3 impulse = basis_[k] * P.segment<3>(3 * k);
@@ -51,15 +51,22 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   }
   // The solver ignores body 0 (fixed) and keeps every joint's velocity constraint (c = 0).
   wrench_[0].setZero();
-  // Only the bodies touched above are non-zero (the elimination needs only their paths); reset them
-  // after the solve.
+  // Only the bodies touched above are non-zero (the elimination needs only their paths).
   touched_.clear();
   for (const Contact& c : contacts) touched_.push_back(c.a), touched_.push_back(c.b);
-  solver_->solve_sparse(wrench_, touched_, du_);
+}
+
+void ContactResponse::clear_wrenches(const std::vector<Contact>& contacts) {
   for (const Contact& c : contacts) {
     wrench_[c.a].setZero();
     wrench_[c.b].setZero();
   }
+}
+
+void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
+  gather_wrenches(contacts, P);
+  solver_->solve_sparse(wrench_, touched_, du_);
+  clear_wrenches(contacts);
 }
 
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
@@ -225,6 +232,13 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
 
 bool ContactResponse::correct(double h, std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
                               double tolerance) {
+  if (!solve_correction(h, velocity, angular, tolerance)) return false;
+  apply_correction(velocity, angular);
+  return true;
+}
+
+bool ContactResponse::solve_correction(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular,
+                                       double tolerance) {
   const std::vector<Contact>& contacts = kept_;
   const int m = static_cast<int>(contacts.size());
   if (m == 0) return false;
@@ -237,12 +251,15 @@ bool ContactResponse::correct(double h, std::vector<Vec3>& velocity, std::vector
   }
   if (!needed) return false;
   solve_contact_law(K_, u_, rows_, P_);
-  respond(contacts, P_);
+  return true;
+}
+
+void ContactResponse::apply_correction(std::vector<Vec3>& velocity, std::vector<Vec3>& angular) {
+  respond(kept_, P_);
   for (int i = 1; i < model_.count; ++i) {
     velocity[i] += du_[i].head<3>();
     angular[i] += du_[i].tail<3>();
   }
-  return true;
 }
 
 }  // namespace aloft

@@ -79,6 +79,20 @@ class ContactResponse {
   // given), the extra impulses applied to `velocity`/`angular`. Returns whether any impulse was needed
   // beyond `tolerance` (m/s of normal velocity).
   bool correct(double h, std::vector<Vec3>& velocity, std::vector<Vec3>& angular, double tolerance);
+  // correct() in two parts, for a caller that applies the impulses itself: solve_correction() solves the
+  // law for them (returns correct()'s answer; the velocities are not changed), then either
+  // apply_correction() adds them to every body, as correct() does, or respond_visiting() hands each body
+  // the solver reaches its velocity change (TreeSolver::solve_sparse_visiting: the joints `also` are
+  // visited whatever skip says; a body it passes over keeps its velocity, u = 0 taken for its subtree).
+  bool solve_correction(double h, const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular,
+                        double tolerance);
+  void apply_correction(std::vector<Vec3>& velocity, std::vector<Vec3>& angular);
+  template <class Skip, class Visit, class Boundary>
+  void respond_visiting(const std::vector<int>& also, Skip&& skip, Visit&& visit, Boundary&& boundary) {
+    gather_wrenches(kept_, P_);
+    solver_->solve_sparse_visiting(wrench_, touched_, also, skip, visit, boundary);
+    clear_wrenches(kept_);
+  }
 
   // The most contacts solved in one step (the collision matrix is 3m x 3m; the contact law's sweeps cost
   // O(m^2) each).
@@ -99,6 +113,9 @@ class ContactResponse {
  private:
   // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_.
   void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
+  // The impulses `P` as wrenches on the contacts' bodies (wrench_, listed in touched_), and back to zero.
+  void gather_wrenches(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
+  void clear_wrenches(const std::vector<Contact>& contacts);
 
   const Model& model_;
   TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose

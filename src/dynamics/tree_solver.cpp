@@ -154,6 +154,16 @@ void TreeSolver::mark_paths(const std::vector<int>& bodies) {
   std::sort(path_.begin(), path_.end(), [](int x, int y) { return x > y; });  // tip to base
 }
 
+void TreeSolver::mark_paths(const std::vector<int>& bodies, const std::vector<int>& also) {
+  const std::vector<int>& parent = model_.parent;
+  for (int b : also)
+    for (int i = b; i > 0 && !on_path_[i]; i = parent[i]) {
+      on_path_[i] = 1;
+      path_.push_back(i);
+    }
+  mark_paths(bodies);  // and sorts them all
+}
+
 void TreeSolver::solve_sparse(const std::vector<Vec6>& f, const std::vector<int>& bodies, std::vector<Vec6>& u) {
   mark_paths(bodies);
   for (const int i : path_) {  // eliminate<true> with c = 0

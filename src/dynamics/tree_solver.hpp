@@ -150,6 +150,16 @@ class TreeSolver {
   template <class Skip, class Visit, class Boundary>
   void solve_listed_rows_visiting(const std::vector<Vec3>& c, const std::vector<int>& listed, Skip&& skip,
                                   Visit&& visit, Boundary&& boundary);
+  // solve_sparse() (wrenches f at the `bodies` listed, c = 0) visiting only the bodies the solve moves
+  // noticeably, as solve_listed_rows_visiting() does: a subtree off the wrenches' paths whose joint point
+  // skip() finds negligible is left as it was (boundary(i) instead of visit). The joints `also` (each
+  // joint i is body i's) are visited whatever skip() says: their bodies' paths are swept as the wrenches'
+  // are (with no wrench of their own), so a caller that must look at them again gets them. The visited
+  // bodies' u are those of solve_sparse() exactly. For the contact passes' impulses, which move the bodies
+  // near the contacts and hardly any other. Needs sparse_rows_possible().
+  template <class Skip, class Visit, class Boundary>
+  void solve_sparse_visiting(const std::vector<Vec6>& f, const std::vector<int>& bodies, const std::vector<int>& also,
+                             Skip&& skip, Visit&& visit, Boundary&& boundary);
 
   // Eliminate three wrench columns (world; rows force then torque) applied at `body_a` (wrench_a) and
   // `body_b` (wrench_b) along the paths to the base, with the last factorization. Either body may be 0
@@ -214,6 +224,12 @@ class TreeSolver {
   // Marks the bodies on the paths from `bodies` to the base (on_path_ = 1) and lists them in path_, tip to
   // base (the sparse solves' tip-to-base sweep).
   void mark_paths(const std::vector<int>& bodies);
+  void mark_paths(const std::vector<int>& bodies, const std::vector<int>& also);  // both lists' paths
+  // The base-to-tip sweep of the skipping solves, after a tip-to-base sweep along path_ (y_ and a_ hold
+  // values only where on_path_ is set): a body off the paths whose joint point skip() finds negligible
+  // has its subtree passed over (boundary(i)); every other body is visited. Clears on_path_ and path_.
+  template <class Skip, class Visit, class Boundary>
+  void substitute_skipping(Skip& skip, Visit& visit, Boundary& boundary);
   // Body i's u = (v_i, w_i) from its joint point's velocity v_j and its turn e_i with the joint point
   // held: w_i = e_i - P_i^T v_j, v_i = v_j - w_i x r_i (substitute's last step).
   [[gnu::always_inline]] Vec6 body_velocity(int i, const Vec3& joint_velocity, const Vec3& turn) const {
@@ -264,7 +280,6 @@ class TreeSolver {
 template <class Skip, class Visit, class Boundary>
 void TreeSolver::solve_listed_rows_visiting(const std::vector<Vec3>& c, const std::vector<int>& listed, Skip&& skip,
                                             Visit&& visit, Boundary&& boundary) {
-  const std::vector<int>& parent = model_.parent;
   mark_paths(listed);
   for (const int b : listed) on_path_[b] = 2;
   for (const int i : path_) {  // eliminate<false> along the paths, c = 0 at the joints not listed
@@ -272,6 +287,24 @@ void TreeSolver::solve_listed_rows_visiting(const std::vector<Vec3>& c, const st
     g_[i].setZero();
     eliminate_body(i, g, on_path_[i] == 2 ? c[i] : Vec3::Zero());
   }
+  substitute_skipping(skip, visit, boundary);
+}
+
+template <class Skip, class Visit, class Boundary>
+void TreeSolver::solve_sparse_visiting(const std::vector<Vec6>& f, const std::vector<int>& bodies,
+                                       const std::vector<int>& also, Skip&& skip, Visit&& visit, Boundary&& boundary) {
+  mark_paths(bodies, also);
+  for (const int i : path_) {  // eliminate<true> along the paths, c = 0 (f is zero off `bodies`)
+    const Vec6 g = g_[i] + f[i];
+    g_[i].setZero();
+    eliminate_body(i, g, Vec3::Zero());
+  }
+  substitute_skipping(skip, visit, boundary);
+}
+
+template <class Skip, class Visit, class Boundary>
+void TreeSolver::substitute_skipping(Skip& skip, Visit& visit, Boundary& boundary) {
+  const std::vector<int>& parent = model_.parent;
   for (int i = 1; i < n_;) {
     const int p = parent[i];
     const bool given = on_path_[i] != 0;

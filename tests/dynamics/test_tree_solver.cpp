@@ -428,6 +428,110 @@ TEST(TreeSolver, ListedRowsSolveVisitsWhatTheFullSolveMovesAndSkipsOnlyWhatItSay
   for (int i = 0; i < model.count; ++i) EXPECT_EQ(once[i], again[i]) << "body " << i;
 }
 
+TEST(TreeSolver, SparseWrenchSolveVisitsWhatTheFullSolveMovesAndTheJointsAskedFor) {
+  // Wrenches on a few bodies (a contact pass's impulses) of a generated mobile at a random pose, and a few
+  // other joints to visit whatever the solve does to them (the joints the pass before left open).
+  // solve_sparse_visiting() must give every body it visits what solve_sparse() gives (number for number:
+  // the same operations along the paths, the same substitution below them); visit every body on the
+  // wrenches' and the asked-for joints' paths; ask skip() only off those paths; pass over exactly the
+  // subtrees it was told to skip, calling boundary() once for each; and leave the solver ready.
+  GenerateOptions options;
+  options.components = 127;
+  options.seed = 4;
+  std::srand(37);
+  const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-127.json"));
+  State state = rest_state(model);
+  for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
+  TreeSolver solver(model);
+  ASSERT_TRUE(solver.sparse_rows_possible());
+  solver.factor(state);
+  std::mt19937 rng(41);
+  std::normal_distribution<double> normal;
+  std::uniform_int_distribution<int> body(1, model.count - 1);
+  const auto on_paths = [&](const std::vector<int>& a, const std::vector<int>& b) {
+    std::vector<char> on(model.count, 0);
+    for (const std::vector<int>* list : {&a, &b})
+      for (int x : *list)
+        for (int i = x; i > 0; i = model.parent[i]) on[i] = 1;
+    return on;
+  };
+  int skipped_somewhere = 0, visited_off_paths = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    // A contact's two bodies (the fixed component among them now and then), one listed twice.
+    std::vector<int> bodies = {body(rng), trial % 3 == 0 ? 0 : body(rng)};
+    bodies.push_back(bodies[0]);
+    std::vector<int> also;
+    for (int k = 0; k < trial % 3; ++k) also.push_back(body(rng));
+    std::vector<Vec6> f(model.count, Vec6::Zero()), full(model.count, Vec6::Zero());
+    for (const int b : bodies)
+      if (b != 0)
+        for (int k = 0; k < 6; ++k) f[b](k) += normal(rng);
+    solver.solve_sparse(f, bodies, full);
+    // Skip below a threshold that leaves some subtrees out (trial 0: skip nothing that moves at all): a
+    // share of the fastest joint point's velocity.
+    double fastest = 0;
+    for (int i = 1; i < model.count; ++i) {
+      const int p = model.parent[i];
+      if (p > 0)
+        fastest = std::max(fastest, (full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i])).cwiseAbs().maxCoeff());
+    }
+    const double threshold = trial == 0 ? 0.0 : 0.01 * trial * fastest;
+    const std::vector<char> on = on_paths(bodies, also);
+    std::vector<int> visited(model.count, 0), bounded(model.count, 0), asked(model.count, 0);
+    std::vector<Vec6> sparse(model.count, Vec6::Constant(NAN));
+    solver.solve_sparse_visiting(
+        f, bodies, also,
+        [&](int i, const Vec3& parent_point) {
+          ++asked[i];
+          EXPECT_FALSE(on[i]) << "asked about body " << i << " on a path";
+          const int p = model.parent[i];
+          const Vec3 expected = p == 0 ? Vec3::Zero()
+                                       : Vec3(full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i]));
+          EXPECT_EQ(parent_point, expected) << "body " << i;
+          return parent_point.cwiseAbs().maxCoeff() <= threshold;
+        },
+        [&](int i, const Vec6& u, const Vec3&) {
+          ++visited[i];
+          sparse[i] = u;
+        },
+        [&](int i) { ++bounded[i]; });
+    for (int i = 1; i < model.count; ++i) {
+      const int p = model.parent[i];
+      if (p > 0 && !visited[p]) {
+        EXPECT_EQ(visited[i] + bounded[i] + asked[i], 0) << "body " << i << " below a skipped body";
+        continue;
+      }
+      EXPECT_EQ(visited[i] + bounded[i], 1) << "body " << i;
+      if (on[i]) {
+        EXPECT_EQ(visited[i], 1) << "body " << i << " on a path";
+      }
+      if (visited[i]) {
+        EXPECT_EQ(sparse[i], full[i]) << "trial " << trial << ", body " << i;
+      } else {
+        const Vec3 parent_point =
+            p == 0 ? Vec3::Zero() : Vec3(full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i]));
+        EXPECT_LE(parent_point.cwiseAbs().maxCoeff(), threshold) << "body " << i;
+      }
+      skipped_somewhere += bounded[i] && !(full[i] == Vec6::Zero());
+      visited_off_paths += visited[i] && !on[i];
+    }
+    for (int j : also) EXPECT_EQ(visited[j], 1) << "joint " << j << " asked for";
+  }
+  EXPECT_GT(skipped_somewhere, 0);
+  EXPECT_GT(visited_off_paths, 0);
+  std::printf("sparse wrenches: %d bodies that move skipped, %d visited off the paths, over the trials\n",
+              skipped_somewhere, visited_off_paths);
+  // The solver is left ready for a plain solve.
+  std::vector<Vec6> f(model.count, Vec6::Zero()), once(model.count, Vec6::Zero()), again(model.count, Vec6::Zero());
+  f[7] = Vec6::Constant(1.0);
+  const std::vector<Vec3> zero_rows(model.count, Vec3::Zero());
+  solver.solve(f, zero_rows, once);
+  solver.solve_sparse_visiting(f, {7}, {3}, [](int, const Vec3&) { return true; },
+                               [](int, const Vec6&, const Vec3&) {}, [](int) {});
+  solver.solve(f, zero_rows, again);
+  for (int i = 0; i < model.count; ++i) EXPECT_EQ(once[i], again[i]) << "body " << i;
+}
+
 TEST(TreeSolver, ListedRowsNeedDepthFirstOrder) {
   // Numbered breadth first (1 -> 2, 3; 2 -> 4; 3 -> 5), body 2's subtree {2, 4} is not a range of
   // indices, so the sparse sweep, which passes over subtrees as ranges, is not offered; numbered depth
