@@ -10,6 +10,7 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 #include "collision/broad_phase.hpp"
+#include "support/breeze.hpp"
 #include "support/shaking.hpp"
 
 namespace aloft {
@@ -153,10 +154,7 @@ TEST(Detector, PairListKeptUpToDateGivesTheContactsOfAFreshDetectorOnALargeMobil
   options.components = 1023;
   const Model m = compile(parse_mobile_text(generate_mobile(options), "generated-1023.json"));
   Simulation sim(m);
-  for (int i = 1; i < m.count; ++i) {
-    const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
-    sim.loads().force[i] = 0.2 * 9.81 * m.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
-  }
+  test::blow_bench_breeze(m, sim);
   CollisionDetector steady(m), forgetful(m);
   forgetful.set_coherence(false);
   std::vector<Contact> remembered, fresh_contacts;

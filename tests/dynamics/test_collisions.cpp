@@ -11,6 +11,7 @@
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
+#include "support/breeze.hpp"
 #include "support/presets.hpp"
 #include "support/shaking.hpp"
 
@@ -254,10 +255,7 @@ TEST(Collisions, CrowdedGeneratedMobileInABreezeKeepsGoing) {
   const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-1023.json"));
   Simulation sim(model);
   ASSERT_TRUE(sim.collisions());
-  for (int i = 1; i < model.count; ++i) {
-    const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
-    sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
-  }
+  test::blow_bench_breeze(model, sim);
   ASSERT_TRUE(sim.advance(0.3)) << sim.failure()->message;
   sim.loads().clear();
   const double kinetic = kinetic_energy(model, sim.state());

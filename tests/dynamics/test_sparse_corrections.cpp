@@ -14,6 +14,8 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 
+#include "support/breeze.hpp"
+
 namespace aloft {
 namespace {
 
@@ -171,10 +173,7 @@ TEST(SparseCorrections, ContactPassesDriftOnlyWhatTheirImpulsesMoveAndEndWhereFu
   const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-255.json"));
   Simulation sim(model);
   ASSERT_TRUE(sim.collisions());
-  for (int i = 1; i < model.count; ++i) {
-    const double a = 2.399963 * i;  // the golden angle, as in `aloft bench`
-    sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
-  }
+  test::blow_bench_breeze(model, sim);
   ASSERT_TRUE(sim.advance(1.0)) << sim.failure()->message;
   sim.loads().clear();
   const double h = model.timestep;
