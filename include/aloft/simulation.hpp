@@ -126,9 +126,10 @@ class Simulation {
   double joint_tolerance(double h) const;
   void set_joint_tolerance(double metres) { fixed_joint_tolerance_ = metres; }
   // Whether a Newton correction that follows a pass leaving few joints open solves for those joints
-  // alone and visits only the bodies it moves (on by default; simulation.cpp, kSparseRowsPer). Off, every
-  // correction is a full solve: for tests and measurements. Mobiles of fewer than 64 bodies, or whose
-  // bodies are not in depth-first order, always take full corrections.
+  // alone and visits only the bodies it moves, and a contact pass after such a pass drifts again only
+  // the bodies its impulses move (on by default; simulation.cpp, kSparseRowsPer and contact_pass_drift).
+  // Off, every correction and contact pass is a full solve and drift: for tests and measurements.
+  // Mobiles of fewer than 64 bodies, or whose bodies are not in depth-first order, always take full ones.
   void set_sparse_corrections(bool on);
 
   // Air damping rates (1/s); default from the model.
