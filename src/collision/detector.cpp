@@ -121,7 +121,9 @@ struct CollisionDetector::Impl {
   bool placed_before = false;
   bool coherence = true;              // keep the pair list and skip pairs by their distances (set_coherence)
   // The pair list, sorted by (a, b), and its piece pairs' distance bounds; per component, the odometer,
-  // margin and skin when the list was made (m).
+  // margin and skin when the list was made (m). The bounds live in one pool: a pair that stays in the
+  // list keeps its range, a new pair's range is added at the end, and a dropped pair's range is left
+  // unused until take_list packs the pool (when it is more than twice the ranges in use).
   std::vector<CandidatePair> list, next_list;
   std::vector<DistanceBound> bounds, next_bounds;
   std::vector<double> listed_odometer, listed_margin, skin;
@@ -233,29 +235,41 @@ struct CollisionDetector::Impl {
   }
 
   // The pair list from the broad phase's overlapping pairs (sorted), less those the filter drops, with
-  // the remembered distances of the pairs already in the old list.
+  // the remembered distances of the pairs already in the old list (their ranges of the pool, as they are).
   void take_list(const std::vector<std::pair<int, int>>& candidates) {
     next_list.clear();
-    next_bounds.clear();
-    std::size_t old = 0;
+    std::size_t old = 0, in_use = 0;
     for (const auto& [a, b] : candidates) {
       while (old < list.size() && (list[old].a < a || (list[old].a == a && list[old].b < b))) ++old;
       const bool kept = old < list.size() && list[old].a == a && list[old].b == b;
       if (!kept && !is_candidate(a, b)) continue;
-      const std::size_t count = geometry[a].pieces.size() * geometry[b].pieces.size();
-      CandidatePair pair{a, b, static_cast<std::uint32_t>(next_bounds.size())};
+      const std::size_t count = pieces_of(a, b);
       if (kept) {
-        pair.lower = list[old].lower, pair.odometer_a = list[old].odometer_a, pair.odometer_b = list[old].odometer_b;
-        next_bounds.insert(next_bounds.end(), bounds.begin() + list[old].bounds,
-                           bounds.begin() + list[old].bounds + static_cast<std::ptrdiff_t>(count));
+        next_list.push_back(list[old]);
       } else {
-        next_bounds.resize(next_bounds.size() + count);
+        next_list.push_back(CandidatePair{a, b, static_cast<std::uint32_t>(bounds.size())});
+        bounds.resize(bounds.size() + count);
       }
-      next_list.push_back(pair);
+      in_use += count;
     }
     std::swap(list, next_list);
-    std::swap(bounds, next_bounds);
+    if (bounds.size() > 2 * in_use) pack_bounds();
     listed = true;
+  }
+
+  // The number of piece pairs (and so of distance bounds) of components a and b.
+  std::size_t pieces_of(int a, int b) const { return geometry[a].pieces.size() * geometry[b].pieces.size(); }
+
+  // The pool of distance bounds with only the list's ranges, in the list's order.
+  void pack_bounds() {
+    next_bounds.clear();
+    for (CandidatePair& pair : list) {
+      const std::size_t count = pieces_of(pair.a, pair.b);
+      const auto from = bounds.begin() + pair.bounds;
+      pair.bounds = static_cast<std::uint32_t>(next_bounds.size());
+      next_bounds.insert(next_bounds.end(), from, from + static_cast<std::ptrdiff_t>(count));
+    }
+    std::swap(bounds, next_bounds);
   }
 
   // Whether every piece pair of a pair of the list is still apart by more than the pair's margin: its
