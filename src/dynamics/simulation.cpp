@@ -567,6 +567,27 @@ inline void start_noting(StepWorkspace& work) {
   work.unlisted_worst = 0;
 }
 
+// Before a sparse pass (a Newton correction's or a contact pass's, after a pass that left few joints
+// open): those joints become work.listed, and nothing is noted yet. The joints not listed keep their gaps
+// unless the solve reaches them (then they are measured again): what is known of the largest of them,
+// returned, stays an upper bound.
+inline double start_sparse_noting(StepWorkspace& work) {
+  std::swap(work.listed, work.open);
+  const double unlisted = work.unlisted_worst;
+  start_noting(work);
+  work.unlisted_worst = unlisted;
+  return unlisted;
+}
+
+// A sparse pass's test for a subtree to pass over: the velocity its joint point is given (m/s, per
+// coordinate) moves it by at most kSparseSkipFraction of the tolerance in the step of h.
+inline auto negligible_motion(const StepWorkspace& work, double h) {
+  const double negligible = kSparseSkipFraction * work.tolerance / h;
+  return [negligible](int, const Vec3& parent_point) __attribute__((always_inline)) {
+    return parent_point.cwiseAbs().maxCoeff() <= negligible;
+  };
+}
+
 }  // namespace
 
 // A pass of rattle()'s drift over all bodies (drift_body, parents first). The first of a step also forms
@@ -625,17 +646,9 @@ double Simulation::correct_and_drift(double h, DriftCorrection correction, bool 
     return worst;
   }
   ++work.statistics.sparse_corrections;
-  // The joints not listed keep their gaps unless the solve reaches them (then they are measured again):
-  // what is known of the largest of them stays an upper bound.
-  std::swap(work.listed, work.open);
-  const double unlisted = work.unlisted_worst;
-  start_noting(work);
-  work.unlisted_worst = unlisted;
+  const double unlisted = start_sparse_noting(work);
   // h |v| is how far the correction moves a point of velocity change v in the drift (both corrections).
-  const double negligible = kSparseSkipFraction * work.tolerance / h;
-  const auto skip = [&](int, const Vec3& parent_point) __attribute__((always_inline)) {
-    return parent_point.cwiseAbs().maxCoeff() <= negligible;
-  };
+  const auto skip = negligible_motion(work, h);
   const auto boundary = [&](int i) __attribute__((always_inline)) {
     const double gap = measure_joint(model_, work, i, h, next.position[i], work.child_arm[i]);
     worst = widest(worst, gap);
@@ -670,16 +683,10 @@ double Simulation::contact_pass_drift(double h) {
     return drift_pass(h, false, false);
   }
   ++work.statistics.sparse_contact_passes;
-  std::swap(work.listed, work.open);
-  const double unlisted = work.unlisted_worst;
-  start_noting(work);
-  work.unlisted_worst = unlisted;
+  const double unlisted = start_sparse_noting(work);
   const State& now = state_;
   double worst = 0;
-  const double negligible = kSparseSkipFraction * work.tolerance / h;
-  const auto skip = [&](int, const Vec3& parent_point) __attribute__((always_inline)) {
-    return parent_point.cwiseAbs().maxCoeff() <= negligible;
-  };
+  const auto skip = negligible_motion(work, h);
   const auto boundary = [&](int i) __attribute__((always_inline)) {
     const double gap = measure_joint(model_, work, i, h, next.position[i], work.child_arm[i]);
     worst = widest(worst, gap);

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <random>
+#include <vector>
 
 #include "aloft/generate.hpp"
 #include "dynamics/tree_solver.hpp"
@@ -313,32 +315,46 @@ TEST(TreeSolver, SparseSolveOfAFewWrenchesEqualsTheFullSolve) {
   }
 }
 
+// generated-127 (seed 4; bodies in depth-first preorder, as compile() orders them) at a random pose drawn
+// after std::srand(seed), for the sparse solves' tests.
+struct RandomPoseMobile {
+  Model model;
+  State state;
+};
+RandomPoseMobile generated_127_at_random_pose(unsigned seed) {
+  GenerateOptions options;
+  options.components = 127;
+  options.seed = 4;
+  std::srand(seed);
+  RandomPoseMobile out{compile(parse_mobile_text(generate_mobile(options), "generated-127.json")), {}};
+  out.state = rest_state(out.model);
+  for (int i = 1; i < out.model.count; ++i) out.state.orientation[i] = Quat::UnitRandom();
+  return out;
+}
+
+// Which bodies lie on the paths to the base from the bodies (or joints: joint i is body i's) listed.
+std::vector<char> on_paths(const Model& model, std::initializer_list<const std::vector<int>*> lists) {
+  std::vector<char> on(model.count, 0);
+  for (const std::vector<int>* list : lists)
+    for (int b : *list)
+      for (int i = b; i > 0; i = model.parent[i]) on[i] = 1;
+  return on;
+}
+
 TEST(TreeSolver, ListedRowsSolveVisitsWhatTheFullSolveMovesAndSkipsOnlyWhatItSaysIsStill) {
   // Joint rows on a few joints of a generated mobile at a random pose (preorder, as compile() orders
   // bodies). solve_listed_rows_visiting() must give every body it visits what the full solve of the same
   // rows gives (number for number: the same operations along the paths, exact zeros elsewhere); pass over
   // exactly the subtrees below the bodies it asked skip() about and was told to skip, calling boundary()
   // for each such body once; and ask skip() only off the listed joints' paths.
-  GenerateOptions options;
-  options.components = 127;
-  options.seed = 4;
-  std::srand(29);
-  const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-127.json"));
-  State state = rest_state(model);
-  for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
+  const RandomPoseMobile mobile = generated_127_at_random_pose(29);
+  const Model& model = mobile.model;
   TreeSolver solver(model);
   ASSERT_TRUE(solver.sparse_rows_possible());
-  solver.factor(state);
+  solver.factor(mobile.state);
   std::mt19937 rng(31);
   std::normal_distribution<double> normal;
   std::uniform_int_distribution<int> joint(1, model.count - 1);
-  // Which bodies lie on a listed joint's path to the base.
-  const auto on_paths = [&](const std::vector<int>& listed) {
-    std::vector<char> on(model.count, 0);
-    for (int b : listed)
-      for (int i = b; i > 0; i = model.parent[i]) on[i] = 1;
-    return on;
-  };
   int skipped_somewhere = 0, visited_off_paths = 0;  // (that the cases above were met at all)
   for (int trial = 0; trial < 12; ++trial) {
     std::vector<int> listed;
@@ -358,7 +374,7 @@ TEST(TreeSolver, ListedRowsSolveVisitsWhatTheFullSolveMovesAndSkipsOnlyWhatItSay
       if (std::find(listed.begin(), listed.end(), i) == listed.end()) given[i] = Vec3::Constant(1e6);
     // Skip below a threshold that leaves some subtrees out (trial 0: skip nothing that moves at all).
     const double threshold = trial == 0 ? 0.0 : 1e-3 * trial;
-    const std::vector<char> on = on_paths(listed);
+    const std::vector<char> on = on_paths(model, {&listed});
     std::vector<int> visited(model.count, 0), bounded(model.count, 0), asked(model.count, 0);
     std::vector<Vec6> sparse(model.count, Vec6::Constant(NAN));
     std::vector<Vec3> sparse_lambda(model.count, Vec3::Constant(NAN));
@@ -435,26 +451,14 @@ TEST(TreeSolver, SparseWrenchSolveVisitsWhatTheFullSolveMovesAndTheJointsAskedFo
   // the same operations along the paths, the same substitution below them); visit every body on the
   // wrenches' and the asked-for joints' paths; ask skip() only off those paths; pass over exactly the
   // subtrees it was told to skip, calling boundary() once for each; and leave the solver ready.
-  GenerateOptions options;
-  options.components = 127;
-  options.seed = 4;
-  std::srand(37);
-  const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-127.json"));
-  State state = rest_state(model);
-  for (int i = 1; i < model.count; ++i) state.orientation[i] = Quat::UnitRandom();
+  const RandomPoseMobile mobile = generated_127_at_random_pose(37);
+  const Model& model = mobile.model;
   TreeSolver solver(model);
   ASSERT_TRUE(solver.sparse_rows_possible());
-  solver.factor(state);
+  solver.factor(mobile.state);
   std::mt19937 rng(41);
   std::normal_distribution<double> normal;
   std::uniform_int_distribution<int> body(1, model.count - 1);
-  const auto on_paths = [&](const std::vector<int>& a, const std::vector<int>& b) {
-    std::vector<char> on(model.count, 0);
-    for (const std::vector<int>* list : {&a, &b})
-      for (int x : *list)
-        for (int i = x; i > 0; i = model.parent[i]) on[i] = 1;
-    return on;
-  };
   int skipped_somewhere = 0, visited_off_paths = 0;
   for (int trial = 0; trial < 12; ++trial) {
     // A contact's two bodies (the fixed component among them now and then), one listed twice.
@@ -476,7 +480,7 @@ TEST(TreeSolver, SparseWrenchSolveVisitsWhatTheFullSolveMovesAndTheJointsAskedFo
         fastest = std::max(fastest, (full[p].head<3>() + full[p].tail<3>().cross(solver.parent_arm()[i])).cwiseAbs().maxCoeff());
     }
     const double threshold = trial == 0 ? 0.0 : 0.01 * trial * fastest;
-    const std::vector<char> on = on_paths(bodies, also);
+    const std::vector<char> on = on_paths(model, {&bodies, &also});
     std::vector<int> visited(model.count, 0), bounded(model.count, 0), asked(model.count, 0);
     std::vector<Vec6> sparse(model.count, Vec6::Constant(NAN));
     solver.solve_sparse_visiting(
