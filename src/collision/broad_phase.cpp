@@ -172,7 +172,7 @@ void BroadPhase::query_everything(int a, std::vector<std::pair<int, int>>& overl
   while (!query_stack_.empty()) {
     const int x = query_stack_.back();  // its subtree box overlaps a's box
     query_stack_.pop_back();
-    if (member_[x] && x != a && parent_[x] != a && parent_[a] != x && overlap(box, boxes_[x])) emit(a, x, overlaps);
+    if (member_[x] && !self_or_joined(a, x) && overlap(box, boxes_[x])) emit(a, x, overlaps);
     for (int k = child_begin_[x]; k < child_begin_[x + 1]; ++k)
       if (overlap(box, subtree_[child_[k]])) query_stack_.push_back(child_[k]);
   }
@@ -200,7 +200,7 @@ void BroadPhase::overlaps_of(const std::vector<int>& changed, std::vector<std::p
   } else {
     for (const int a : changed)
       for (const int x : order_)
-        if (x != a && parent_[x] != a && parent_[a] != x && overlap(boxes_[a], boxes_[x])) emit(a, x, overlaps);
+        if (!self_or_joined(a, x) && overlap(boxes_[a], boxes_[x])) emit(a, x, overlaps);
   }
   // Two changed components that overlap each other are found from both.
   std::sort(overlaps.begin(), overlaps.end());

@@ -62,6 +62,8 @@ class BroadPhase {
  private:
   // Whether sweep() goes through the tree (else sweep and prune); fixed by reset().
   bool through_tree() const;
+  // Whether x is a itself, its parent or one of its children: never a pair (overlaps_of's looks).
+  bool self_or_joined(int a, int x) const { return x == a || parent_[x] == a || parent_[a] == x; }
   // Every member of the whole tree whose box overlaps member a's, paired with a (a itself, its parent
   // and its children left out: joined).
   void query_everything(int a, std::vector<std::pair<int, int>>& overlaps);

@@ -304,6 +304,48 @@ TEST(BroadPhase, LeavesOutAParentAndItsChildButNotSiblings) {
   EXPECT_EQ(overlaps_of({}), (std::vector<std::pair<int, int>>{{1, 2}, {1, 3}, {2, 3}}));
 }
 
+// The broad phase's tests: a random tree of `count` components (parent[i] < i, as compiled mobiles order
+// them; shape 0 a random tree, 1 a chain, 2 a star), about 80 % of them members (with a box).
+struct RandomForest {
+  std::vector<int> parent, members;
+};
+RandomForest random_forest(int count, int shape, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  RandomForest out{std::vector<int>(count, -1), {}};
+  for (int i = 1; i < count; ++i)
+    out.parent[i] = shape == 0 ? static_cast<int>(unit(rng) * i) : shape == 1 ? i - 1 : 0;
+  for (int i = 0; i < count; ++i)
+    if (unit(rng) < 0.8) out.members.push_back(i);
+  return out;
+}
+
+// A random box on a coarse grid (0.025 m), up to 0.2 m a side: many boxes touch exactly.
+internal::WorldBox random_grid_box(std::mt19937& rng) {
+  std::uniform_int_distribution<int> grid(0, 40);
+  std::uniform_int_distribution<int> extent(0, 8);
+  const Vec3 low(0.025 * grid(rng), 0.025 * grid(rng), 0.025 * grid(rng));
+  const Vec3 size(0.025 * extent(rng), 0.025 * extent(rng), 0.025 * extent(rng));
+  return {low, low + size};
+}
+
+// What the broad phase must find, by testing every pair of members: the pairs (a < b, sorted) whose
+// closed boxes overlap, a parent and its child left out, of those that counts(a, b) accepts.
+template <class Counts>
+std::vector<std::pair<int, int>> every_pair_overlapping(const RandomForest& forest,
+                                                        const std::vector<internal::WorldBox>& boxes, Counts counts) {
+  std::vector<std::pair<int, int>> out;
+  const std::vector<int>& members = forest.members;
+  for (std::size_t x = 0; x < members.size(); ++x) {
+    for (std::size_t y = x + 1; y < members.size(); ++y) {
+      const int a = members[x], b = members[y];  // a < b
+      if (forest.parent[b] == a || !counts(a, b)) continue;
+      const internal::WorldBox &p = boxes[a], &q = boxes[b];
+      if ((p.low.array() <= q.high.array()).all() && (q.low.array() <= p.high.array()).all()) out.emplace_back(a, b);
+    }
+  }
+  return out;
+}
+
 TEST(BroadPhase, FindsExactlyThePairsThatATestOfEveryPairFinds) {
   // Random trees (parent[i] < i, as compiled mobiles order them), chains up to 2000 deep, and stars;
   // random boxes, some components without one (not members), coordinates on a coarse grid so that many
@@ -311,39 +353,19 @@ TEST(BroadPhase, FindsExactlyThePairsThatATestOfEveryPairFinds) {
   // below 512 members and for the stars, the tree's subtree boxes from 512 on) only prune: the pairs must
   // be those of the all-pairs test, parent-child pairs left out.
   std::mt19937 rng(11);
-  std::uniform_int_distribution<int> grid(0, 40);
-  std::uniform_int_distribution<int> extent(0, 8);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   int trees = 0;
   long long pairs_seen = 0;
   for (const int count : {1, 2, 3, 17, 100, 600, 700, 2000}) {  // (about 80 % members: the tree from 700 on)
     for (const int shape : {0, 1, 2}) {  // random tree, chain, star
-      std::vector<int> parent(count, -1);
-      for (int i = 1; i < count; ++i)
-        parent[i] = shape == 0 ? static_cast<int>(unit(rng) * i) : shape == 1 ? i - 1 : 0;
-      std::vector<int> members;
-      for (int i = 0; i < count; ++i)
-        if (unit(rng) < 0.8) members.push_back(i);
+      const RandomForest forest = random_forest(count, shape, rng);
       internal::BroadPhase broad;
-      broad.reset(members, count, static_cast<int>(unit(rng) * 3), parent);
+      broad.reset(forest.members, count, static_cast<int>(unit(rng) * 3), forest.parent);
       std::vector<internal::WorldBox> boxes(count);
-      for (const int i : members) {
-        const Vec3 low(0.025 * grid(rng), 0.025 * grid(rng), 0.025 * grid(rng));
-        const Vec3 size(0.025 * extent(rng), 0.025 * extent(rng), 0.025 * extent(rng));
-        boxes[i] = {low, low + size};
-        broad.box(i) = boxes[i];
-      }
-      std::vector<std::pair<int, int>> found, expected;
+      for (const int i : forest.members) broad.box(i) = boxes[i] = random_grid_box(rng);
+      std::vector<std::pair<int, int>> found;
       broad.sweep(found);
-      for (std::size_t x = 0; x < members.size(); ++x) {
-        for (std::size_t y = x + 1; y < members.size(); ++y) {
-          const int a = members[x], b = members[y];  // a < b
-          if (parent[b] == a) continue;
-          const internal::WorldBox &p = boxes[a], &q = boxes[b];
-          if ((p.low.array() <= q.high.array()).all() && (q.low.array() <= p.high.array()).all())
-            expected.emplace_back(a, b);
-        }
-      }
+      const std::vector<std::pair<int, int>> expected = every_pair_overlapping(forest, boxes, [](int, int) { return true; });
       ASSERT_EQ(found, expected) << count << " components, shape " << shape;
       ++trees;
       pairs_seen += static_cast<long long>(expected.size());
@@ -357,31 +379,20 @@ TEST(BroadPhase, OverlapsOfChangedBoxesAreThoseATestOfEveryPairFinds) {
   // As above (random trees, chains and stars, both ways of sweeping), then rounds of moving a random few
   // of the boxes: overlaps_of() on those must give exactly the overlapping pairs that have one of them,
   // as the all-pairs test finds them, whatever moved in the rounds before (the tree's subtree boxes are
-  // only grown between sweeps).
+  // made tight again along each moved box's path to the root, not only grown).
   std::mt19937 rng(13);
-  std::uniform_int_distribution<int> grid(0, 40);
-  std::uniform_int_distribution<int> extent(0, 8);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   long long pairs_seen = 0;
   int rounds = 0;
   for (const int count : {2, 17, 100, 700, 2000}) {
     for (const int shape : {0, 1, 2}) {  // random tree, chain, star
-      std::vector<int> parent(count, -1);
-      for (int i = 1; i < count; ++i)
-        parent[i] = shape == 0 ? static_cast<int>(unit(rng) * i) : shape == 1 ? i - 1 : 0;
-      std::vector<int> members;
-      for (int i = 0; i < count; ++i)
-        if (unit(rng) < 0.8) members.push_back(i);
+      const RandomForest forest = random_forest(count, shape, rng);
+      const std::vector<int>& members = forest.members;
       if (members.empty()) continue;
       internal::BroadPhase broad;
-      broad.reset(members, count, static_cast<int>(unit(rng) * 3), parent);
+      broad.reset(members, count, static_cast<int>(unit(rng) * 3), forest.parent);
       std::vector<internal::WorldBox> boxes(count);
-      const auto place = [&](int i) {
-        const Vec3 low(0.025 * grid(rng), 0.025 * grid(rng), 0.025 * grid(rng));
-        const Vec3 size(0.025 * extent(rng), 0.025 * extent(rng), 0.025 * extent(rng));
-        boxes[i] = {low, low + size};
-        broad.box(i) = boxes[i];
-      };
+      const auto place = [&](int i) { broad.box(i) = boxes[i] = random_grid_box(rng); };
       for (const int i : members) place(i);
       std::vector<std::pair<int, int>> found;
       broad.sweep(found);
@@ -398,16 +409,8 @@ TEST(BroadPhase, OverlapsOfChangedBoxesAreThoseATestOfEveryPairFinds) {
           place(i);
         }
         broad.overlaps_of(changed, found);
-        std::vector<std::pair<int, int>> expected;
-        for (std::size_t x = 0; x < members.size(); ++x) {
-          for (std::size_t y = x + 1; y < members.size(); ++y) {
-            const int a = members[x], b = members[y];  // a < b
-            if (parent[b] == a || !(changed_flag[a] || changed_flag[b])) continue;
-            const internal::WorldBox &p = boxes[a], &q = boxes[b];
-            if ((p.low.array() <= q.high.array()).all() && (q.low.array() <= p.high.array()).all())
-              expected.emplace_back(a, b);
-          }
-        }
+        const std::vector<std::pair<int, int>> expected = every_pair_overlapping(
+            forest, boxes, [&](int a, int b) { return changed_flag[a] || changed_flag[b]; });
         ASSERT_EQ(found, expected) << count << " components, shape " << shape << ", round " << round;
         pairs_seen += static_cast<long long>(expected.size());
         for (const int i : changed) changed_flag[i] = 0;
