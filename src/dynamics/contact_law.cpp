@@ -93,12 +93,21 @@ using Mat3d = Eigen::Matrix3d;
 // The impulse that changes the contact velocity by `change` through the (symmetric, positive
 // semi-definite) block K: K^-1 change, or, when K is singular, the least-squares impulse of least norm
 // (K's pseudo-inverse): the part of `change` no impulse can produce is left out instead of being bought
-// with an unbounded impulse. Formed once per contact and solve (the block does not change between
-// Gauss-Seidel sweeps) as a matrix, K^-1 by LDL^T solves of the unit vectors or the pseudo-inverse, so
-// that a sweep's solve is one 3x3 product.
+// with an unbounded impulse. Formed once per contact and solve, when the contact first needs it (the
+// block does not change between Gauss-Seidel sweeps; a contact that separates without an impulse in every
+// sweep, most of a tangle's, never does), as a matrix, K^-1 by LDL^T solves of the unit vectors or the
+// pseudo-inverse, so that a sweep's solve is one 3x3 product.
 class BlockSolver {
  public:
-  explicit BlockSolver(const Mat3d& K) {
+  // K^-1 change for this contact's block K (the same K at every call).
+  Vec3d solve(const Mat3d& K, const Vec3d& change) {
+    if (!formed_) form(K);
+    return inverse_ * change;
+  }
+
+ private:
+  void form(const Mat3d& K) {
+    formed_ = true;
     const Eigen::LDLT<Mat3d> ldlt(K);
     const Vec3d pivots = ldlt.vectorD().cwiseAbs();
     if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kSingularBlock * pivots.maxCoeff()) {
@@ -114,10 +123,9 @@ class BlockSolver {
     for (int k = 0; k < 3; ++k) inverse_values[k] = values[k] > cutoff ? 1.0 / values[k] : 0.0;
     inverse_ = vectors * inverse_values.asDiagonal() * vectors.transpose();
   }
-  Vec3d solve(const Vec3d& change) const { return inverse_ * change; }
 
- private:
-  Mat3d inverse_;  // K^-1, or K's pseudo-inverse when K is singular
+  bool formed_ = false;
+  Mat3d inverse_;  // K^-1, or K's pseudo-inverse when K is singular (once formed_)
 };
 
 // Sliding against the slip the impulse leaves (Coulomb's law): the impulse P = p (1, -mu e) on the
@@ -233,7 +241,7 @@ enum class Mode : char { kNone, kSticking, kSliding, kNormalOnly };
 // and how it meets the law (`mode`). `slide` (unit, tangent basis): the direction the contact slipped
 // along in the last sweep (zero if it did not slide), where the sliding solve starts; set to this
 // one's (zero if it does not slide).
-Vec3d contact_impulse(const Mat3d& K, const BlockSolver& block, const Vec3d& u_free, const ContactLawRow& row,
+Vec3d contact_impulse(const Mat3d& K, BlockSolver& block, const Vec3d& u_free, const ContactLawRow& row,
                       Mode& mode, Eigen::Vector2d& slide) {
   mode = Mode::kNone;
   const Eigen::Vector2d previous = slide;
@@ -244,7 +252,7 @@ Vec3d contact_impulse(const Mat3d& K, const BlockSolver& block, const Vec3d& u_f
 
   // Mirtich's prediction: the impulse that makes the contact stick (normal target met, no slip).
   const Vec3d wanted(row.target_normal, 0, 0);
-  const Vec3d stick = block.solve(wanted - u_free);
+  const Vec3d stick = block.solve(K, wanted - u_free);
   const double tangential = stick.tail<2>().norm();
   if (std::isfinite(tangential) && stick.x() > 0 && tangential <= row.friction * stick.x()) {
     mode = Mode::kSticking;
@@ -382,9 +390,7 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   std::vector<Eigen::Vector2d> slide(m, Eigen::Vector2d::Zero());  // per contact: its slip's direction
   std::vector<double> change_of(m, 0.0);  // per contact: how much its impulse changed in the last sweep
   int polishes = 0;
-  std::vector<BlockSolver> blocks;
-  blocks.reserve(m);
-  for (int k = 0; k < m; ++k) blocks.emplace_back(K.block<3, 3>(3 * k, 3 * k));
+  std::vector<BlockSolver> blocks(m);  // formed as the contacts need them
   double velocity_scale = u.cwiseAbs().maxCoeff();
   for (const ContactLawRow& row : rows) velocity_scale = std::max(velocity_scale, std::abs(row.target_normal));
   Eigen::VectorXd sweep_start(3 * m);
