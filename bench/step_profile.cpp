@@ -5,7 +5,10 @@
 // step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
 // the function to give callgrind's --toggle-collect.
 //
-//   aloft_step_profile MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
+//   aloft_step_profile [--every N] MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
+//     --every N: also print, after every N steps, the same figures for those N steps alone (how a run's
+//       cost changes along it: a generated mobile with collisions tangles, and its late steps cost many
+//       times its early ones; docs/performance.md)
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
 //     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
 //       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
@@ -23,6 +26,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -48,13 +52,64 @@ __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
   return true;
 }
 
+// What the simulation counted between two points of a run (Simulation::step_statistics and the collision
+// statistics' friction_dropped), per step of the `steps` between them.
+struct Counts {
+  aloft::StepStatistics steps;
+  long long friction_dropped = 0, impulses = 0;
+};
+
+Counts counts_of(const aloft::Simulation& sim) {
+  return {sim.step_statistics(), sim.collision_statistics().friction_dropped, sim.collision_statistics().impulses};
+}
+
+// Prints the per-step figures of `steps` steps between `before` and `after`, each line starting with
+// `indent`.
+void print_rates(const char* indent, const Counts& before, const Counts& after, long steps) {
+  using aloft::StepStatistics;
+  const auto per_step = [&](long long StepStatistics::*count) {
+    return static_cast<double>(after.steps.*count - before.steps.*count) / steps;
+  };
+  std::printf("%sper step: %.3f (sub)steps tried, %.3f taken, %.3f kicks retried; rejected: %.3f spin (turn %.3f, anchor "
+              "%.3f, drift %.3f over), %.3f contact turn, %.3f joints, %.3f contact motion\n",
+              indent, per_step(&StepStatistics::attempts), per_step(&StepStatistics::accepted),
+              per_step(&StepStatistics::kicks_retried), per_step(&StepStatistics::rejected_spin),
+              per_step(&StepStatistics::spin_turn_over), per_step(&StepStatistics::spin_anchor_over),
+              per_step(&StepStatistics::spin_drift_over), per_step(&StepStatistics::rejected_contact_turn),
+              per_step(&StepStatistics::rejected_joints), per_step(&StepStatistics::rejected_contact_motion));
+  const double sparse = per_step(&StepStatistics::sparse_corrections);
+  const double sparse_passes = per_step(&StepStatistics::sparse_contact_passes);
+  std::printf("%sper step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
+              "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes (%.3f of them "
+              "sparse, drifting %.0f bodies each), %.3f pushes, %.3f friction dropped, %.2f contact impulses\n",
+              indent, per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
+              per_step(&StepStatistics::push_corrections), sparse,
+              sparse > 0 ? per_step(&StepStatistics::sparse_bodies) / sparse : 0.0,
+              per_step(&StepStatistics::contact_passes), sparse_passes,
+              sparse_passes > 0 ? per_step(&StepStatistics::sparse_contact_pass_bodies) / sparse_passes : 0.0,
+              per_step(&StepStatistics::pushes),
+              static_cast<double>(after.friction_dropped - before.friction_dropped) / steps,
+              static_cast<double>(after.impulses - before.impulses) / steps);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace aloft;
+  long every = 0;  // --every N: steps per block of the per-block report (0: none)
+  if (argc > 2 && std::string(argv[1]) == "--every") {
+    char* end = nullptr;
+    every = std::strtol(argv[2], &end, 10);
+    if (*argv[2] == '\0' || *end != '\0' || every <= 0) {
+      std::fprintf(stderr, "aloft_step_profile: --every takes a whole number of steps > 0, not '%s'\n", argv[2]);
+      return 2;
+    }
+    argc -= 2;
+    argv += 2;
+  }
   if (argc < 3) {
     std::fprintf(stderr,
-                 "usage: aloft_step_profile MOBILE(.json or component count) STEPS [collisions 0|1] "
+                 "usage: aloft_step_profile [--every N] MOBILE(.json or component count) STEPS [collisions 0|1] "
                  "[breeze|swinging[:SEED]] [joint tolerance, m]\n");
     return 2;
   }
@@ -105,11 +160,26 @@ int main(int argc, char** argv) {
     }
     sim.set_joint_tolerance(joint_tolerance);
     const long long halvings = sim.subdivisions(), iterations = sim.joint_iterations();
-    const StepStatistics before = sim.step_statistics();
-    const long long friction_dropped_before = sim.collision_statistics().friction_dropped;
-    const double start = thread_seconds();
-    if (!timed_steps(sim, steps)) throw std::runtime_error(sim.failure()->message);
-    const double seconds = thread_seconds() - start;
+    const Counts before = counts_of(sim);
+    // The timed steps, in blocks of `every` when asked (each block printed as it ends; the steps and the
+    // checksum are the same either way).
+    double seconds = 0;
+    for (long done = 0; done < steps;) {
+      const long block = every > 0 ? std::min(every, steps - done) : steps;
+      const Counts block_start = counts_of(sim);
+      const long long block_halvings = sim.subdivisions();
+      const double start = thread_seconds();
+      if (!timed_steps(sim, block)) throw std::runtime_error(sim.failure()->message);
+      const double block_seconds = thread_seconds() - start;
+      seconds += block_seconds;
+      if (every > 0) {
+        std::printf("steps %ld-%ld: %.1f us/step, %.3f halvings per step\n", done, done + block,
+                    1e6 * block_seconds / block, static_cast<double>(sim.subdivisions() - block_halvings) / block);
+        print_rates("    ", block_start, counts_of(sim), block);
+        std::fflush(stdout);
+      }
+      done += block;
+    }
     const double subdivided = static_cast<double>(sim.subdivisions() - halvings);
     double checksum = 0;
     for (int i = 1; i < model.count; ++i)
@@ -117,30 +187,7 @@ int main(int argc, char** argv) {
     std::printf("%s: %.3f us/step, %.4f us per component-step, %.3f halvings and %.2f solves per step; checksum %.17g\n",
                 what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
                 (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
-    const StepStatistics& after = sim.step_statistics();
-    const auto per_step = [&](long long StepStatistics::*count) {
-      return static_cast<double>(after.*count - before.*count) / steps;
-    };
-    std::printf("  per step: %.3f (sub)steps tried, %.3f taken, %.3f kicks retried; rejected: %.3f spin (turn %.3f, anchor %.3f, "
-                "drift %.3f over), %.3f contact turn, %.3f joints, %.3f contact motion\n",
-                per_step(&StepStatistics::attempts), per_step(&StepStatistics::accepted),
-                per_step(&StepStatistics::kicks_retried),
-                per_step(&StepStatistics::rejected_spin), per_step(&StepStatistics::spin_turn_over),
-                per_step(&StepStatistics::spin_anchor_over), per_step(&StepStatistics::spin_drift_over),
-                per_step(&StepStatistics::rejected_contact_turn), per_step(&StepStatistics::rejected_joints),
-                per_step(&StepStatistics::rejected_contact_motion));
-    const double sparse = per_step(&StepStatistics::sparse_corrections);
-    const double sparse_passes = per_step(&StepStatistics::sparse_contact_passes);
-    std::printf("  per step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
-                "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes (%.3f of them "
-                "sparse, drifting %.0f bodies each), %.3f pushes, %.3f friction dropped\n",
-                per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
-                per_step(&StepStatistics::push_corrections), sparse,
-                sparse > 0 ? per_step(&StepStatistics::sparse_bodies) / sparse : 0.0,
-                per_step(&StepStatistics::contact_passes), sparse_passes,
-                sparse_passes > 0 ? per_step(&StepStatistics::sparse_contact_pass_bodies) / sparse_passes : 0.0,
-                per_step(&StepStatistics::pushes),
-                static_cast<double>(sim.collision_statistics().friction_dropped - friction_dropped_before) / steps);
+    print_rates("  ", before, counts_of(sim), steps);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aloft_step_profile: %s\n", e.what());
     return 1;
