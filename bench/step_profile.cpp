@@ -22,7 +22,8 @@
 // (sub)steps went (Simulation::step_statistics): the tries and those taken, the rejections by their
 // cause, the Newton corrections by phase, the contact passes (and how many bodies the sparse ones drift)
 // and overlap pushes, and, with collisions
-// on, the (sub)steps whose contact law dropped friction (CollisionStatistics::friction_dropped).
+// on, the (sub)steps whose contact law dropped friction (CollisionStatistics::friction_dropped) and those
+// that dropped it at some contacts only (friction_dropped_in_part).
 
 #include <time.h>
 
@@ -53,14 +54,16 @@ __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
 }
 
 // What the simulation counted between two points of a run (Simulation::step_statistics and the collision
-// statistics' friction_dropped), per step of the `steps` between them.
+// statistics' friction_dropped, friction_dropped_in_part and impulses), per step of the `steps` between
+// them.
 struct Counts {
   aloft::StepStatistics steps;
-  long long friction_dropped = 0, impulses = 0;
+  long long friction_dropped = 0, friction_dropped_in_part = 0, impulses = 0;
 };
 
 Counts counts_of(const aloft::Simulation& sim) {
-  return {sim.step_statistics(), sim.collision_statistics().friction_dropped, sim.collision_statistics().impulses};
+  const aloft::CollisionStatistics& c = sim.collision_statistics();
+  return {sim.step_statistics(), c.friction_dropped, c.friction_dropped_in_part, c.impulses};
 }
 
 // Prints the per-step figures of `steps` steps between `before` and `after`, each line starting with
@@ -81,7 +84,8 @@ void print_rates(const char* indent, const Counts& before, const Counts& after, 
   const double sparse_passes = per_step(&StepStatistics::sparse_contact_passes);
   std::printf("%sper step: Newton corrections %.3f after the drift, %.3f after contact passes, %.3f under "
               "pushes (%.3f of them sparse, visiting %.0f bodies each); %.3f contact passes (%.3f of them "
-              "sparse, drifting %.0f bodies each), %.3f pushes, %.3f friction dropped, %.2f contact impulses\n",
+              "sparse, drifting %.0f bodies each), %.3f pushes, %.3f friction dropped (and %.3f at some contacts), "
+              "%.2f contact impulses\n",
               indent, per_step(&StepStatistics::joint_corrections), per_step(&StepStatistics::contact_pass_corrections),
               per_step(&StepStatistics::push_corrections), sparse,
               sparse > 0 ? per_step(&StepStatistics::sparse_bodies) / sparse : 0.0,
@@ -89,6 +93,7 @@ void print_rates(const char* indent, const Counts& before, const Counts& after, 
               sparse_passes > 0 ? per_step(&StepStatistics::sparse_contact_pass_bodies) / sparse_passes : 0.0,
               per_step(&StepStatistics::pushes),
               static_cast<double>(after.friction_dropped - before.friction_dropped) / steps,
+              static_cast<double>(after.friction_dropped_in_part - before.friction_dropped_in_part) / steps,
               static_cast<double>(after.impulses - before.impulses) / steps);
 }
 

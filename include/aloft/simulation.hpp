@@ -49,6 +49,9 @@ struct CollisionStatistics {
   long long impulses = 0;             // contact impulses applied (one per active contact per step)
   long long sliding = 0;              // of those, sliding on the friction cone's edge
   long long restitution_dropped = 0;  // steps where bouncing would have added energy (solved with e = 0)
+  long long friction_dropped_in_part = 0;  // steps where the law with friction did not converge, and was
+                                          // solved again without the friction of the contacts that kept
+                                          // changing only (the others kept theirs)
   long long friction_dropped = 0;     // steps where the law with friction did not converge or even that
                                       // gained (nearly dependent contacts): solved without friction, or
                                       // without impulse

@@ -60,6 +60,15 @@ constexpr double kSingularPivot = 1e-12;
 // sweeps' work (each weighted by m^2).
 constexpr int kForecastWindow = 30;
 
+// When Gauss-Seidel with friction does not converge, the contacts whose impulse changed, in the last
+// kRecentSweeps sweeps or more, by at least kUnsettledFraction of the largest such change are solved again
+// without friction, the others with theirs (solve_contact_law); only if that does not converge either is
+// friction dropped at every contact. The solves that do not converge are a cluster of a few strongly
+// coupled contacts cycling between sticking and sliding while the rest have settled (see
+// kForecastWindow); a contact coupled to the cluster changes with it, in proportion to the coupling.
+constexpr int kRecentSweeps = 10;
+constexpr double kUnsettledFraction = 1e-3;
+
 // The sweeps' changes, kept for the forecast.
 class ConvergenceForecast {
  public:
@@ -377,18 +386,22 @@ bool polish_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& velocity, const
   return true;
 }
 
-}  // namespace
-
-ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
-                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P) {
+// Block Gauss-Seidel on the law from P = 0 (P resized to 3m, m >= 1), with the Newton polish now and
+// then: true when it converged (see kRelativeChange). `sweeps` counts the sweeps; `recent_change` (per
+// contact) is set to the largest change of its impulse (max norm, N s) over the last sweeps, at least
+// kRecentSweeps of them, which tells the contacts still moving when it did not converge. `sticking` and
+// `sliding` count the contacts that ended so.
+bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std::vector<ContactLawRow>& rows,
+                  Eigen::VectorXd& P, int& sweeps, std::vector<double>& recent_change, int& sticking, int& sliding) {
   const int m = static_cast<int>(rows.size());
-  ContactLawResult result;
   P.setZero(3 * m);
-  if (m == 0) return result;
   Eigen::VectorXd velocity = u;  // u + K P, kept current
   std::vector<Mode> mode(m, Mode::kNone);
   std::vector<Eigen::Vector2d> slide(m, Eigen::Vector2d::Zero());  // per contact: its slip's direction
   std::vector<double> change_of(m, 0.0);  // per contact: how much its impulse changed in the last sweep
+  // Per contact, the largest change over the sweeps since the window was last restarted, and over the
+  // window before (the two together cover kRecentSweeps to 2 kRecentSweeps sweeps).
+  std::vector<double> window_change(m, 0.0), last_window_change(m, 0.0);
   int polishes = 0;
   std::vector<BlockSolver> blocks(m);  // formed as the contacts need them
   double velocity_scale = u.cwiseAbs().maxCoeff();
@@ -397,7 +410,11 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   bool converged = false;
   ConvergenceForecast forecast;
   for (int sweep = 1; sweep <= kMaxSweeps; ++sweep) {
-    result.iterations = sweep;
+    sweeps = sweep;
+    if (sweep % kRecentSweeps == 1 && sweep > 1) {
+      std::swap(window_change, last_window_change);
+      std::fill(window_change.begin(), window_change.end(), 0.0);
+    }
     double largest_change = 0, largest_impulse = 0;
     sweep_start = velocity;
     for (int k = 0; k < m; ++k) {
@@ -411,6 +428,7 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
         P.segment<3>(3 * k) = next;
       }
       change_of[k] = change.cwiseAbs().maxCoeff();
+      window_change[k] = std::max(window_change[k], change_of[k]);
       largest_change = std::max(largest_change, change_of[k]);
       largest_impulse = std::max(largest_impulse, next.cwiseAbs().maxCoeff());
     }
@@ -426,6 +444,48 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
       if (polish_law(K, velocity, rows, mode, change_of, P)) velocity.noalias() = u + K * P;
     }
   }
+  recent_change.resize(m);
+  for (int k = 0; k < m; ++k) recent_change[k] = std::max(window_change[k], last_window_change[k]);
+  sticking = sliding = 0;
+  for (int k = 0; k < m; ++k) {
+    if (!(P[3 * k] > 0)) continue;
+    if (mode[k] == Mode::kSliding) ++sliding;
+    else ++sticking;
+  }
+  return converged;
+}
+
+}  // namespace
+
+ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
+                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P) {
+  const int m = static_cast<int>(rows.size());
+  ContactLawResult result;
+  P.setZero(3 * m);
+  if (m == 0) return result;
+  std::vector<double> recent_change;
+  bool converged = gauss_seidel(K, u, rows, P, result.iterations, recent_change, result.sticking, result.sliding);
+  if (!converged) {
+    // The contacts that kept changing (a cluster trading sticking for sliding, see kUnsettledFraction)
+    // lose their friction for this solve, and the law is solved again: the others keep theirs.
+    const double largest = *std::max_element(recent_change.begin(), recent_change.end());
+    std::vector<ContactLawRow> calmer = rows;
+    int unsettled = 0, with_friction = 0;
+    for (int k = 0; k < m; ++k) {
+      if (!(rows[k].friction > 0)) continue;
+      ++with_friction;
+      if (recent_change[k] >= kUnsettledFraction * largest) {
+        calmer[k].friction = 0;
+        ++unsettled;
+      }
+    }
+    if (unsettled > 0 && unsettled < with_friction) {
+      int sweeps = 0;
+      converged = gauss_seidel(K, u, calmer, P, sweeps, recent_change, result.sticking, result.sliding);
+      result.iterations += sweeps;
+      if (converged) result.frictionless_contacts = unsettled;
+    }
+  }
   if (!converged) {
     // Block Gauss-Seidel with friction need not converge: contacts coupled through one body can keep
     // trading sticking for sliding (ContactLaw.DependentContactsMeetTheLaw: a body landing on four corners,
@@ -436,13 +496,10 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
     for (int k = 0; k < m; ++k) target[k] = rows[k].target_normal;
     solve_frictionless_law(K, u(Eigen::seqN(0, m, 3)), target, P);
     result.friction_dropped = true;
+    result.sticking = result.sliding = 0;
+    result.frictionless_contacts = m;
     result.energy_change = contact_energy_change(K, u, P);
     return result;
-  }
-  for (int k = 0; k < m; ++k) {
-    if (!(P[3 * k] > 0)) continue;
-    if (mode[k] == Mode::kSliding) ++result.sliding;
-    else ++result.sticking;
   }
   result.energy_change = contact_energy_change(K, u, P);
   return result;

@@ -32,9 +32,13 @@ struct ContactLawResult {
   int sticking = 0;       // contacts that ended sticking (P_n > 0, inside the cone)
   int sliding = 0;        // contacts that ended on the cone's edge
   double energy_change = 0;  // J: u^T P + P^T K P / 2, the change of kinetic energy the impulses make
-  // Gauss-Seidel with friction did not converge in its sweeps: P is the frictionless normal law's
-  // solution instead (sticking and sliding are then 0).
+  // Gauss-Seidel with friction did not converge in its sweeps, not even with the contacts that kept
+  // changing solved without friction: P is the frictionless normal law's solution instead (sticking and
+  // sliding are then 0).
   bool friction_dropped = false;
+  // The contacts solved without friction: those that kept changing when Gauss-Seidel with friction did
+  // not converge (solved again without theirs, the others with theirs), or all m when friction_dropped.
+  int frictionless_contacts = 0;
 };
 
 // Solves for P (resized to 3m). K must be 3m x 3m, u 3m.

@@ -193,8 +193,10 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       law.energy_change = 0;
     }
     report.friction_dropped = true;
+    law.frictionless_contacts = m;
   }
   report.friction_dropped = report.friction_dropped || law.friction_dropped;
+  report.frictionless = law.frictionless_contacts;
   report.iterations = law.iterations;
   report.sticking = law.sticking;
   report.sliding = law.sliding;

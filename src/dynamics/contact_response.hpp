@@ -54,6 +54,10 @@ struct ContactStepReport {
   int sliding = 0;
   int iterations = 0;          // Gauss-Seidel sweeps of the contact law
   bool restitution_dropped = false;  // Newton restitution would have added energy: solved with e = 0
+  int frictionless = 0;              // contacts solved without friction: those whose impulses kept changing
+                                     // where the law with friction did not converge (the others kept
+                                     // theirs: ContactLawResult::frictionless_contacts), or all of them
+                                     // when friction_dropped
   bool friction_dropped = false;     // the law with friction did not converge, or added energy (nearly
                                      // dependent contacts): solved frictionless, or with no impulse if
                                      // that gained too

@@ -860,6 +860,7 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
         contact_report.sliding += again.sliding;
         contact_report.restitution_dropped = contact_report.restitution_dropped || again.restitution_dropped;
         contact_report.friction_dropped = contact_report.friction_dropped || again.friction_dropped;
+        contact_report.frictionless = std::max(contact_report.frictionless, again.frictionless);
         contact_report.energy_change += again.energy_change;
         contact_report.deepest = std::max(contact_report.deepest, again.deepest);
       }
@@ -1031,6 +1032,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.sliding += contact_report.sliding;
     stats.restitution_dropped += contact_report.restitution_dropped;
     stats.friction_dropped += contact_report.friction_dropped;
+    stats.friction_dropped_in_part += !contact_report.friction_dropped && contact_report.frictionless > 0;
     stats.energy_removed -= std::min(0.0, contact_report.energy_change);
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
   }
