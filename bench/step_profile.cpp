@@ -23,7 +23,10 @@
 // cause, the Newton corrections by phase, the contact passes (and how many bodies the sparse ones drift)
 // and overlap pushes, and, with collisions
 // on, the (sub)steps whose contact law dropped friction (CollisionStatistics::friction_dropped) and those
-// that dropped it at some contacts only (friction_dropped_in_part).
+// that dropped it at some contacts only (friction_dropped_in_part), the contact law's solves, their size
+// (contacts per solve: the law and the collision matrix cost O(m^2) in it) and sweeps, and the closing
+// contacts left unsolved beyond ContactResponse::kMaxContacts (CollisionStatistics::law_solves ...), all
+// of the (sub)steps taken.
 
 #include <time.h>
 
@@ -59,11 +62,13 @@ __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
 struct Counts {
   aloft::StepStatistics steps;
   long long friction_dropped = 0, friction_dropped_in_part = 0, impulses = 0;
+  long long law_solves = 0, law_contacts = 0, law_sweeps = 0, contacts_left = 0;
 };
 
 Counts counts_of(const aloft::Simulation& sim) {
   const aloft::CollisionStatistics& c = sim.collision_statistics();
-  return {sim.step_statistics(), c.friction_dropped, c.friction_dropped_in_part, c.impulses};
+  return {sim.step_statistics(), c.friction_dropped, c.friction_dropped_in_part, c.impulses,
+          c.law_solves, c.law_contacts, c.law_sweeps, c.contacts_left};
 }
 
 // Prints the per-step figures of `steps` steps between `before` and `after`, each line starting with
@@ -95,6 +100,13 @@ void print_rates(const char* indent, const Counts& before, const Counts& after, 
               static_cast<double>(after.friction_dropped - before.friction_dropped) / steps,
               static_cast<double>(after.friction_dropped_in_part - before.friction_dropped_in_part) / steps,
               static_cast<double>(after.impulses - before.impulses) / steps);
+  const long long solves = after.law_solves - before.law_solves;
+  std::printf("%sper step: %.3f contact-law solves, for %.1f contacts and %.1f sweeps each; %.3f closing contacts "
+              "left unsolved (beyond the most a solve takes)\n",
+              indent, static_cast<double>(solves) / steps,
+              solves > 0 ? static_cast<double>(after.law_contacts - before.law_contacts) / solves : 0.0,
+              solves > 0 ? static_cast<double>(after.law_sweeps - before.law_sweeps) / solves : 0.0,
+              static_cast<double>(after.contacts_left - before.contacts_left) / steps);
 }
 
 }  // namespace

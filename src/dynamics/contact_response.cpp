@@ -106,6 +106,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   }
   const int m = static_cast<int>(contacts.size());
   if (m == 0) return report;
+  report.solves = 1;
+  report.solved = m;
 
   // Contact frames, lever arms and the velocities before the impulse (a relative to b, contact basis).
   basis_.resize(m);

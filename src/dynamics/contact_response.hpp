@@ -49,6 +49,8 @@ struct ContactTuning {
 struct ContactStepReport {
   int contacts = 0;            // speculative contacts reported by the detector
   int dropped = 0;             // closing contacts beyond kMaxContacts, left to the next step
+  int solves = 0;              // contact-law solves (a resolve() with contacts to solve makes one)
+  int solved = 0;              // contacts those solves were for (the collision matrix is 3 solved square)
   int active = 0;              // contacts that received an impulse
   int sticking = 0;
   int sliding = 0;

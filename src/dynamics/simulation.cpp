@@ -855,6 +855,10 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
         const ContactStepReport again =
             work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
         contact_report.contacts = again.contacts;
+        contact_report.dropped = again.dropped;  // what the step leaves unsolved is the last list's
+        contact_report.solves += again.solves;
+        contact_report.solved += again.solved;
+        contact_report.iterations += again.iterations;
         contact_report.active += again.active;
         contact_report.sticking += again.sticking;
         contact_report.sliding += again.sliding;
@@ -1033,6 +1037,10 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.restitution_dropped += contact_report.restitution_dropped;
     stats.friction_dropped += contact_report.friction_dropped;
     stats.friction_dropped_in_part += !contact_report.friction_dropped && contact_report.frictionless > 0;
+    stats.law_solves += contact_report.solves;
+    stats.law_contacts += contact_report.solved;
+    stats.law_sweeps += contact_report.iterations;
+    stats.contacts_left += contact_report.dropped;
     stats.energy_removed -= std::min(0.0, contact_report.energy_change);
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
   }

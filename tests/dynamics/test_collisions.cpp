@@ -213,6 +213,13 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   }
   const CollisionStatistics& stats = sim.collision_statistics();
   EXPECT_GT(stats.impulses, 100) << "the shaking should make the pieces knock";
+  // The contact law's counts agree with each other: every impulse is at a contact some solve was for,
+  // every solve sweeps at least once, and a (sub)step makes at most two solves (the second when the look
+  // after the impulses finds other contacts).
+  EXPECT_GE(stats.law_contacts, stats.impulses);
+  EXPECT_GE(stats.law_sweeps, stats.law_solves);
+  EXPECT_LE(stats.law_solves, 2 * stats.steps_with_contacts);
+  EXPECT_GT(stats.law_solves, 0);
   EXPECT_LT(worst_left_overlap, 2.5e-4);
   // Nothing gets through anything, even while knocked about: no contact, at the start of any (sub)step,
   // is deeper than the thinnest sheet (1.5 mm; measured 0.58 mm, 0.48-0.61 mm over 24 seeds of this

@@ -227,6 +227,44 @@ TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
   EXPECT_GT(sliding, 5);  // the sliding branch was exercised
 }
 
+// More closing contacts than one solve takes (ContactResponse::kMaxContacts): the soonest to close are
+// solved, the rest left for the next step and counted (ContactStepReport::dropped, which the simulation's
+// CollisionStatistics::contacts_left sums), with the solve's size in `solved`. Velocities are scaled to
+// mm/s so that a contact's gap after two steps is its distance to within 2 h |u_n| ~ 2e-6 m: the
+// overlapping ones (-0.1 mm) close before the shallow ones (+0.04 mm, inside the slop, so kept as
+// candidates).
+TEST(ContactResponse, MoreClosingContactsThanASolveTakesLeaveTheLatestAndAreCounted) {
+  constexpr int kShallow = 5;
+  for (const int deep : {10, ContactResponse::kMaxContacts}) {
+    RandomContactCase test_case(7, false, 0.5, 0);
+    const Model& model = test_case.model;
+    State state = test_case.state;
+    for (int i = 1; i < model.count; ++i) state.velocity[i] *= 1e-3, state.angular[i] *= 1e-3;
+    std::vector<Contact> contacts;
+    for (int k = 0; k < deep + kShallow; ++k) {
+      const int a = k % (model.count - 1), b = a + 1;  // each body against the next (a may be the hook)
+      Contact c = approaching_contact(state, a, b, 0.01 * Vec3::Random(), Vec3::Random());
+      c.distance = k < deep ? -1e-4 : 4e-5;
+      contacts.push_back(c);
+    }
+    ContactResponse response(model);
+    std::vector<Vec6> pseudo(model.count, Vec6::Zero());
+    bool has_pseudo = false;
+    const ContactStepReport report = response.resolve(state, test_case.solver, contacts, 1e-3, state.velocity,
+                                                      state.angular, pseudo, has_pseudo);
+    const int solvable = std::min(deep + kShallow, ContactResponse::kMaxContacts);
+    EXPECT_EQ(report.contacts, deep + kShallow);
+    EXPECT_EQ(report.solves, 1);
+    EXPECT_EQ(report.solved, solvable);
+    EXPECT_EQ(report.dropped, deep + kShallow - solvable);
+    EXPECT_GE(report.iterations, 1);
+    ASSERT_EQ(static_cast<int>(response.kept().size()), solvable);
+    int shallow_kept = 0;
+    for (const Contact& c : response.kept()) shallow_kept += c.distance > 0;
+    EXPECT_EQ(shallow_kept, solvable - deep) << "the overlapping contacts close first and are solved first";
+  }
+}
+
 // The contact pass (Simulation's step, after the joints' Newton corrections): when the joints' impulses
 // made the kept contacts approach again, correct() applies extra impulses. After it no contact
 // approaches, the joints still move together and no energy is added.
