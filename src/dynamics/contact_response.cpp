@@ -166,6 +166,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   };
   set_targets(true);
   ContactLawResult law = solve_contact_law(K_, u_, rows_, P_);
+  int sweeps = law.iterations;
   // Energy may only leave: allow round-off relative to the energies the impulses exchange.
   const auto gained = [&](const ContactLawResult& r) {
     const double scale = std::abs(u_.dot(P_)) + 1e-300;
@@ -174,6 +175,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   if (any_bounce && gained(law)) {
     set_targets(false);
     law = solve_contact_law(K_, u_, rows_, P_);
+    sweeps += law.iterations;
     report.restitution_dropped = true;
   }
   // Block Gauss-Seidel with friction need not converge when the contacts' rows are nearly dependent (two
@@ -199,7 +201,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   }
   report.friction_dropped = report.friction_dropped || law.friction_dropped;
   report.frictionless = law.frictionless_contacts;
-  report.iterations = law.iterations;
+  report.iterations = sweeps;
   report.sticking = law.sticking;
   report.sliding = law.sliding;
   report.energy_change = law.energy_change;

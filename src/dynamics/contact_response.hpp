@@ -49,12 +49,14 @@ struct ContactTuning {
 struct ContactStepReport {
   int contacts = 0;            // speculative contacts reported by the detector
   int dropped = 0;             // closing contacts beyond kMaxContacts, left to the next step
-  int solves = 0;              // contact-law solves (a resolve() with contacts to solve makes one)
+  int solves = 0;              // contact-law problems: one per resolve() with contacts to solve (solved
+                               // again without bounce when that would add energy; `iterations` has both)
   int solved = 0;              // contacts those solves were for (the collision matrix is 3 solved square)
   int active = 0;              // contacts that received an impulse
   int sticking = 0;
   int sliding = 0;
-  int iterations = 0;          // Gauss-Seidel sweeps of the contact law
+  int iterations = 0;          // Gauss-Seidel sweeps of the contact law (both solves' when the bounce
+                               // was dropped and the law solved again)
   bool restitution_dropped = false;  // Newton restitution would have added energy: solved with e = 0
   int frictionless = 0;              // contacts solved without friction: those whose impulses kept changing
                                      // where the law with friction did not converge (the others kept
