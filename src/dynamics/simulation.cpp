@@ -1029,7 +1029,9 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   next.time = now.time + h;
   std::swap(state_, next);
   work.factored = true;
-  if (contact_report.contacts > 0) {
+  // (A look after the impulses may find no contacts left, `contacts` then 0, after the first look's were
+  // solved: `solves` still counts that step.)
+  if (contact_report.contacts > 0 || contact_report.solves > 0) {
     CollisionStatistics& stats = collision_stats_;
     ++stats.steps_with_contacts;
     stats.impulses += contact_report.active;
