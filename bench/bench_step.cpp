@@ -13,7 +13,10 @@
 //
 // items_per_second is steps (or factorizations, solves) per second of CPU time; us_per_component_step is
 // the CPU time per moving component (count - 1) and per step, in microseconds. The mobiles start swinging
-// (bench_models.hpp: swinging_state), so that the joint iterations do real work.
+// (bench_models.hpp: swinging_state), so that the joint iterations do real work. The step benchmarks also
+// count halvings and tree solves per step and, with collisions on, the contact law's solves per step
+// (law_solves) and the contacts per solve (law_contacts: its sweeps and collision matrix cost O(m^2) in
+// them), as aloft_step_profile does.
 
 #include <benchmark/benchmark.h>
 #include <time.h>
@@ -114,6 +117,12 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions) {
     const double halvings = static_cast<double>(sim.subdivisions());
     state.counters["halvings"] = halvings / steps;
     state.counters["solves"] = (static_cast<double>(sim.joint_iterations()) + steps + halvings) / steps;
+    const aloft::CollisionStatistics& contacts = sim.collision_statistics();
+    if (collisions && contacts.law_solves > 0) {
+      state.counters["law_solves"] = static_cast<double>(contacts.law_solves) / steps;
+      state.counters["law_contacts"] =
+          static_cast<double>(contacts.law_contacts) / static_cast<double>(contacts.law_solves);
+    }
   }
 }
 
