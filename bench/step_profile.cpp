@@ -56,27 +56,25 @@ __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
   return true;
 }
 
-// What the simulation counted between two points of a run (Simulation::step_statistics and the collision
-// statistics' friction_dropped, friction_dropped_in_part and impulses), per step of the `steps` between
-// them.
+// What the simulation counted at one point of a run (Simulation::step_statistics and
+// collision_statistics); print_rates gives the differences between two, per step.
 struct Counts {
   aloft::StepStatistics steps;
-  long long friction_dropped = 0, friction_dropped_in_part = 0, impulses = 0;
-  long long law_solves = 0, law_contacts = 0, law_sweeps = 0, contacts_left = 0;
+  aloft::CollisionStatistics collisions;
 };
 
-Counts counts_of(const aloft::Simulation& sim) {
-  const aloft::CollisionStatistics& c = sim.collision_statistics();
-  return {sim.step_statistics(), c.friction_dropped, c.friction_dropped_in_part, c.impulses,
-          c.law_solves, c.law_contacts, c.law_sweeps, c.contacts_left};
-}
+Counts counts_of(const aloft::Simulation& sim) { return {sim.step_statistics(), sim.collision_statistics()}; }
 
 // Prints the per-step figures of `steps` steps between `before` and `after`, each line starting with
 // `indent`.
 void print_rates(const char* indent, const Counts& before, const Counts& after, long steps) {
   using aloft::StepStatistics;
+  using aloft::CollisionStatistics;
   const auto per_step = [&](long long StepStatistics::*count) {
     return static_cast<double>(after.steps.*count - before.steps.*count) / steps;
+  };
+  const auto collision_count = [&](long long CollisionStatistics::*count) {
+    return static_cast<double>(after.collisions.*count - before.collisions.*count);
   };
   std::printf("%sper step: %.3f (sub)steps tried, %.3f taken, %.3f kicks retried; rejected: %.3f spin (turn %.3f, anchor "
               "%.3f, drift %.3f over), %.3f contact turn, %.3f joints, %.3f contact motion\n",
@@ -97,16 +95,15 @@ void print_rates(const char* indent, const Counts& before, const Counts& after, 
               per_step(&StepStatistics::contact_passes), sparse_passes,
               sparse_passes > 0 ? per_step(&StepStatistics::sparse_contact_pass_bodies) / sparse_passes : 0.0,
               per_step(&StepStatistics::pushes),
-              static_cast<double>(after.friction_dropped - before.friction_dropped) / steps,
-              static_cast<double>(after.friction_dropped_in_part - before.friction_dropped_in_part) / steps,
-              static_cast<double>(after.impulses - before.impulses) / steps);
-  const long long solves = after.law_solves - before.law_solves;
+              collision_count(&CollisionStatistics::friction_dropped) / steps,
+              collision_count(&CollisionStatistics::friction_dropped_in_part) / steps,
+              collision_count(&CollisionStatistics::impulses) / steps);
+  const double solves = collision_count(&CollisionStatistics::law_solves);
   std::printf("%sper step: %.3f contact-law solves, for %.1f contacts and %.1f sweeps each; %.3f closing contacts "
               "left unsolved (beyond the most a solve takes)\n",
-              indent, static_cast<double>(solves) / steps,
-              solves > 0 ? static_cast<double>(after.law_contacts - before.law_contacts) / solves : 0.0,
-              solves > 0 ? static_cast<double>(after.law_sweeps - before.law_sweeps) / solves : 0.0,
-              static_cast<double>(after.contacts_left - before.contacts_left) / steps);
+              indent, solves / steps, solves > 0 ? collision_count(&CollisionStatistics::law_contacts) / solves : 0.0,
+              solves > 0 ? collision_count(&CollisionStatistics::law_sweeps) / solves : 0.0,
+              collision_count(&CollisionStatistics::contacts_left) / steps);
 }
 
 }  // namespace
