@@ -1,4 +1,5 @@
-// Closed-form contacts: sphere-sphere, cylinder-sphere, cylinder-cylinder side to side. World frame, m.
+// Closed-form contacts: sphere-sphere, cylinder-sphere, cylinder-cylinder side to side; and the closest
+// points of two segments (two wires' capsules). World frame, m.
 
 #include <algorithm>
 #include <cmath>
@@ -92,6 +93,41 @@ bool cylinder_cylinder_sides(const Vec3& pa, const Vec3& qa, double ra, const Ve
   out.distance = len - ra - rb;
   out.point = 0.5 * ((on_a - ra * n) + (on_b + rb * n));
   return true;
+}
+
+SegmentClosest segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  // Ericson, Real-Time Collision Detection 5.1.9: minimise |p0 + s d1 - (q0 + t d2)| over s, t in [0, 1],
+  // the parameter of one segment clamped and the other's recomputed from it (and clamped in turn).
+  const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (!(a > 0) && !(e > 0)) {
+    // Both points.
+  } else if (!(a > 0)) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (!(e > 0)) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2);
+      const double denom = a * e - b * b;  // |d1 x d2|^2 >= 0; 0 when parallel: any s, take 0
+      s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  SegmentClosest out;
+  out.on_p = p0 + s * d1;
+  out.on_q = q0 + t * d2;
+  out.distance = (out.on_p - out.on_q).norm();
+  return out;
 }
 
 }  // namespace aloft::internal

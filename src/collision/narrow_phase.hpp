@@ -7,7 +7,8 @@
 //
 // Closed forms (exact): sphere-sphere, cylinder-sphere (flat-ended cylinder: side, rim and end faces),
 // cylinder-cylinder when the closest points of the two axes lie strictly inside both axes (side to side;
-// then exact when apart, the capsule depth when overlapping). Everything else (an end of a wire
+// then exact when apart, the capsule depth when overlapping); two wires otherwise are settled by their
+// capsules' gap (segment_segment) when that is beyond the margin. Everything else (an end of a wire
 // involved, boxes, plate parts, mesh pieces) goes through support functions: GJK distance
 // (gjk_distance.hpp) when apart, libccd's GJK + EPA with both pieces inflated by margin / 2 when they
 // overlap (gjk_contact.cpp).
@@ -37,6 +38,16 @@ PieceContact cylinder_sphere(const Vec3& from, const Vec3& to, double rc, const 
 // both strictly inside their segments: an end face or rim is then involved and the caller uses GJK.
 bool cylinder_cylinder_sides(const Vec3& from_a, const Vec3& to_a, double ra, const Vec3& from_b,
                              const Vec3& to_b, double rb, PieceContact& out);
+
+// The closest points of two segments p0-p1 and q0-q1 (world, m), and their distance: exact at rounding
+// for every configuration, parallel, crossing and degenerate (a segment of zero length is its point)
+// included. Two wires lie inside the capsules of their axes and radii, so this distance minus the radii
+// never exceeds the wires' own gap.
+struct SegmentClosest {
+  Vec3 on_p = Vec3::Zero(), on_q = Vec3::Zero();
+  double distance = 0;
+};
+SegmentClosest segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
 
 // Support-function contact: GJK distance when apart, libccd's EPA when overlapping. True, with `out`,
 // when the signed distance is below `margin` (> 0). When false, out.distance is a lower bound of the
