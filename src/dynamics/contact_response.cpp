@@ -36,6 +36,7 @@ Vec3 relative_velocity(const Contact& c, const Vec3& arm_a, const Vec3& arm_b, c
 
 ContactResponse::ContactResponse(const Model& model)
     : model_(model),
+      path_position_(model.count, -1),
       wrench_(model.count, Vec6::Zero()),
       du_(model.count, Vec6::Zero()) {}
 
@@ -139,13 +140,18 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     on_b.bottomRows<3>() = -skew(arm_b_[k]) * basis_[k];
     solver.eliminate_on_paths(c.a, on_a, c.b, on_b, columns_[k]);
   }
+  // Column by column of blocks: contact l's path marked in path_position_, each block above the
+  // diagonal found by walking contact k's path alone (TreeSolver::coupling_indexed).
   K_.resize(3 * m, 3 * m);
-  for (int k = 0; k < m; ++k) {
-    for (int l = k; l < m; ++l) {
-      const Mat3 block = TreeSolver::coupling(columns_[k], columns_[l]);
+  for (int l = 0; l < m; ++l) {
+    const PathColumns& y = columns_[l];
+    for (std::size_t q = 0; q < y.node.size(); ++q) path_position_[static_cast<std::size_t>(y.node[q])] = static_cast<int>(q);
+    for (int k = 0; k <= l; ++k) {
+      const Mat3 block = TreeSolver::coupling_indexed(columns_[k], y, path_position_);
       K_.block<3, 3>(3 * k, 3 * l) = block;
       K_.block<3, 3>(3 * l, 3 * k) = block.transpose();
     }
+    for (int node : y.node) path_position_[static_cast<std::size_t>(node)] = -1;
   }
 
   // Targets: bounce what collides fast within this step; let the rest close their gap but not pass it.

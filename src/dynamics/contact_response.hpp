@@ -133,6 +133,7 @@ class ContactResponse {
   std::vector<Vec3> arm_a_, arm_b_;  // centre of mass of a (b) -> contact point, world, m
   std::vector<ContactLawRow> rows_;
   std::vector<PathColumns> columns_;  // per contact, reused (no allocation once grown)
+  std::vector<int> path_position_;    // per body: its index in one contact's columns_.node, or -1
   Eigen::MatrixXd K_;
   Eigen::VectorXd u_, P_;
   std::vector<Vec6> wrench_;   // per body, zero between uses

@@ -233,6 +233,15 @@ Mat3 TreeSolver::coupling(const PathColumns& x, const PathColumns& y) {
   return out;
 }
 
+Mat3 TreeSolver::coupling_indexed(const PathColumns& x, const PathColumns& y, const std::vector<int>& position_in_y) {
+  Mat3 out = Mat3::Zero();
+  for (std::size_t p = 0; p < x.node.size(); ++p) {
+    const int q = position_in_y[static_cast<std::size_t>(x.node[p])];
+    if (q >= 0) out.noalias() += x.h[p].transpose() * y.e[static_cast<std::size_t>(q)];
+  }
+  return out;
+}
+
 Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state) {
   const int m = model.count - 1;  // moving bodies 1..n-1 -> blocks 0..m-1
   const int size = 9 * m;

@@ -275,6 +275,11 @@ TEST(TreeSolver, PathColumnsCouplingEqualsFullSolves) {
         EXPECT_LE((sparse - dense).norm(), 1e-10 * dense.norm())
             << (chain ? "chain" : "tree") << " seed " << seed << " trial " << trial;
         EXPECT_LE((TreeSolver::coupling(y, x) - sparse.transpose()).norm(), 1e-12 * sparse.norm());
+        // With y's path looked up instead of merged: the same sum in the same order, so bit for bit.
+        std::vector<int> position(static_cast<std::size_t>(model.count), -1);
+        for (std::size_t q = 0; q < y.node.size(); ++q) position[static_cast<std::size_t>(y.node[q])] = static_cast<int>(q);
+        const Mat3 indexed = TreeSolver::coupling_indexed(x, y, position);
+        EXPECT_TRUE(indexed == sparse) << (chain ? "chain" : "tree") << " seed " << seed << " trial " << trial;
       }
     }
   }
