@@ -155,6 +155,11 @@ struct CollisionDetector::Impl {
   void place(const State& state, double step, double base_margin) {
     for (int i : members) {
       const ComponentGeometry& g = geometry[i];
+      margin[i] = component_margin(g, state.velocity[i], state.angular[i], step, base_margin);
+      // Not moved since the last call (the look after a knock, at the same pose): the pose, and the
+      // odometer, stay as they are.
+      if (placed_before && state.position[i] == last_position[i] && state.orientation[i].coeffs() == last_orientation[i].coeffs())
+        continue;
       if (placed_before) {
         // |q1 . q2| = cos(angle / 2); a point at distance r from the centre moves by 2 sin(angle / 2) r.
         const double c = std::min(1.0, std::abs(last_orientation[i].dot(state.orientation[i])));
@@ -164,7 +169,6 @@ struct CollisionDetector::Impl {
       last_orientation[i] = state.orientation[i];
       last_position[i] = state.position[i];
       pose[i] = {state.orientation[i].toRotationMatrix(), state.position[i]};
-      margin[i] = component_margin(g, state.velocity[i], state.angular[i], step, base_margin);
     }
     placed_before = true;
   }
