@@ -129,9 +129,36 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   // The collision matrix K = G H^-1 G^T from path-sparse columns: each contact's three unit impulses
   // (along its basis) eliminated only along the paths from its two bodies to the base, and every 3x3 block
   // summed over the nodes two contacts' paths share. O(m depth) for the columns and O(m^2 depth) for the
-  // blocks, instead of 3m full O(n) tree solves.
+  // blocks, instead of 3m full O(n) tree solves. What the last resolve at this factorization computed for
+  // the same contacts is taken as it is (last_contacts_): the same numbers, bit for bit.
+  std::swap(columns_, last_columns_);
+  std::swap(K_, last_K_);
+  const bool same_factorization = have_last_ && solver.factorizations() == last_factorization_;
+  same_as_last_.assign(static_cast<std::size_t>(m), -1);
+  if (same_factorization) {
+    // Both lists are sorted by (a, b) (the detector's order, kept by the kMaxContacts cut), so one merge.
+    std::size_t j = 0;
+    for (int k = 0; k < m; ++k) {
+      const Contact& c = contacts[k];
+      const auto before = [&](const Contact& q) { return q.a < c.a || (q.a == c.a && q.b < c.b); };
+      while (j < last_contacts_.size() && before(last_contacts_[j])) ++j;
+      for (std::size_t i = j; i < last_contacts_.size() && last_contacts_[i].a == c.a && last_contacts_[i].b == c.b; ++i) {
+        const Contact& q = last_contacts_[i];
+        if (q.point == c.point && q.normal == c.normal && last_arm_a_[i] == arm_a_[k] && last_arm_b_[i] == arm_b_[k]) {
+          same_as_last_[static_cast<std::size_t>(k)] = static_cast<int>(i);
+          break;
+        }
+      }
+    }
+  }
   if (static_cast<int>(columns_.size()) < m) columns_.resize(m);
   for (int k = 0; k < m; ++k) {
+    const int was = same_as_last_[static_cast<std::size_t>(k)];
+    if (was >= 0) {
+      columns_[k] = last_columns_[static_cast<std::size_t>(was)];
+      ++report.reused;
+      continue;
+    }
     const Contact& c = contacts[k];
     Mat63 on_a, on_b;
     on_a.topRows<3>() = basis_[k];
@@ -141,18 +168,36 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     solver.eliminate_on_paths(c.a, on_a, c.b, on_b, columns_[k]);
   }
   // Column by column of blocks: contact l's path marked in path_position_, each block above the
-  // diagonal found by walking contact k's path alone (TreeSolver::coupling_indexed).
+  // diagonal found by walking contact k's path alone (TreeSolver::coupling_indexed), or taken from the
+  // last K where both contacts were there in the same order.
   K_.resize(3 * m, 3 * m);
   for (int l = 0; l < m; ++l) {
     const PathColumns& y = columns_[l];
-    for (std::size_t q = 0; q < y.node.size(); ++q) path_position_[static_cast<std::size_t>(y.node[q])] = static_cast<int>(q);
+    const int was_l = same_as_last_[static_cast<std::size_t>(l)];
+    bool marked = false;
     for (int k = 0; k <= l; ++k) {
+      const int was_k = same_as_last_[static_cast<std::size_t>(k)];
+      if (was_k >= 0 && was_l >= 0 && was_k <= was_l) {
+        K_.block<3, 3>(3 * k, 3 * l) = last_K_.block<3, 3>(3 * was_k, 3 * was_l);
+        K_.block<3, 3>(3 * l, 3 * k) = last_K_.block<3, 3>(3 * was_l, 3 * was_k);
+        continue;
+      }
+      if (!marked) {
+        for (std::size_t q = 0; q < y.node.size(); ++q) path_position_[static_cast<std::size_t>(y.node[q])] = static_cast<int>(q);
+        marked = true;
+      }
       const Mat3 block = TreeSolver::coupling_indexed(columns_[k], y, path_position_);
       K_.block<3, 3>(3 * k, 3 * l) = block;
       K_.block<3, 3>(3 * l, 3 * k) = block.transpose();
     }
-    for (int node : y.node) path_position_[static_cast<std::size_t>(node)] = -1;
+    if (marked)
+      for (int node : y.node) path_position_[static_cast<std::size_t>(node)] = -1;
   }
+  last_contacts_.assign(contacts.begin(), contacts.end());
+  last_arm_a_.assign(arm_a_.begin(), arm_a_.begin() + m);
+  last_arm_b_.assign(arm_b_.begin(), arm_b_.begin() + m);
+  last_factorization_ = solver.factorizations();
+  have_last_ = true;
 
   // Targets: bounce what collides fast within this step; let the rest close their gap but not pass it.
   const double threshold = std::max(tuning.bounce_threshold, 2.0 * model_.gravity.norm() * h);

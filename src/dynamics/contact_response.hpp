@@ -52,6 +52,8 @@ struct ContactStepReport {
   int solves = 0;              // contact-law problems: one per resolve() with contacts to solve (solved
                                // again without bounce when that would add energy; `iterations` has both)
   int solved = 0;              // contacts those solves were for (the collision matrix is 3 solved square)
+  int reused = 0;              // of those, contacts whose columns of the collision matrix came from the
+                               // resolve before at the same factorization (the same contact found again)
   int active = 0;              // contacts that received an impulse
   int sticking = 0;
   int sliding = 0;
@@ -135,6 +137,17 @@ class ContactResponse {
   std::vector<PathColumns> columns_;  // per contact, reused (no allocation once grown)
   std::vector<int> path_position_;    // per body: its index in one contact's columns_.node, or -1
   Eigen::MatrixXd K_;
+  // The last resolve's contacts, lever arms, path columns and K, and the solver factorization they were
+  // computed with (TreeSolver::factorizations): a contact of the next resolve identical to one of them
+  // (same components, point, normal and arms) at the same factorization has the same columns, and two
+  // such the same block of K. The look after a step's impulses finds most of the same contacts again.
+  std::vector<Contact> last_contacts_;
+  std::vector<Vec3> last_arm_a_, last_arm_b_;
+  std::vector<PathColumns> last_columns_;
+  Eigen::MatrixXd last_K_;
+  std::uint64_t last_factorization_ = 0;
+  bool have_last_ = false;
+  std::vector<int> same_as_last_;  // per contact of this resolve: its index in the last one's, or -1
   Eigen::VectorXd u_, P_;
   std::vector<Vec6> wrench_;   // per body, zero between uses
   std::vector<int> touched_;   // the bodies wrench_ is non-zero at (each contact's two)

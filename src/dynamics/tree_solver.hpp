@@ -30,6 +30,7 @@
 // The arrays are sized once; nothing allocates after construction.
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 
@@ -182,6 +183,9 @@ class TreeSolver {
   // World inertia tensors and their inverses at the factored pose.
   const std::vector<Mat3>& world_inertia() const { return inertia_; }
   const std::vector<Mat3>& world_inverse_inertia() const { return inverse_inertia_; }
+  // How many factorizations this solver has made: two results computed from it with the same count are
+  // from the same factorization (what may be kept between the uses of one pose's, ContactResponse).
+  std::uint64_t factorizations() const { return factorizations_; }
 
  private:
   // The factorization's tip-to-base sweep (defined below the class); with kEliminate also eliminate()
@@ -248,6 +252,7 @@ class TreeSolver {
   int n_;
   std::vector<char> leaf_;          // body i has no child joint (fixed by the topology)
   std::vector<Vec3> inverse_moments_;     // 1 / principal moments
+  std::uint64_t factorizations_ = 0;      // factor_blocks() calls so far
   std::vector<Mat3> rotation_scratch_;    // factor(State): rotation matrices of the orientations
   std::vector<Vec3> child_arm_;     // r_k, world
   std::vector<Vec3> parent_arm_;    // s_k, world
@@ -347,6 +352,7 @@ Eigen::MatrixXd dense_kkt_matrix(const Model& model, const State& state);
 // With kStack, the children's folds are carried on folded_ instead of sum_a_, sum_b_, sum_c_ and g_.
 template <bool kEliminate, bool kStack, class Wrench>
 ALOFT_CPU_DISPATCH void TreeSolver::factor_blocks(const std::vector<Mat3>& rotation, Wrench& wrench) {
+  ++factorizations_;
   const std::vector<int>& parent = model_.parent;
   int top = 0;  // kStack: folded_[1..top] in use
   for (int i = n_ - 1; i >= 1; --i) {

@@ -265,6 +265,53 @@ TEST(ContactResponse, MoreClosingContactsThanASolveTakesLeaveTheLatestAndAreCoun
   }
 }
 
+// The look after a step's impulses finds most of the step's contacts again, at the same pose: resolve()
+// then takes their columns of the collision matrix, and the blocks between them, from the resolve before
+// instead of computing them again. The result must be the same, bit for bit, as a fresh response's (which
+// computes everything) for a second list that drops one contact, keeps the others in order and adds new
+// ones; and nothing may be taken once the solver has factored again.
+TEST(ContactResponse, ContactsFoundAgainAtTheSameFactorizationGiveTheSameResultBitForBit) {
+  int reused = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    RandomContactCase test_case(seed, true, 0.8, 6);
+    const Model& model = test_case.model;
+    TreeSolver& solver = test_case.solver;
+    std::vector<Contact> first = test_case.contacts;
+    const auto by_pair = [](const Contact& x, const Contact& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; };
+    std::stable_sort(first.begin(), first.end(), by_pair);
+    std::vector<Contact> second(first.begin() + 1, first.end());
+    second.push_back(approaching_contact(test_case.state, 0, model.count - 1, 0.1 * Vec3::Random(), Vec3::Random()));
+    second.push_back(approaching_contact(test_case.state, 1, 2, 0.1 * Vec3::Random(), Vec3::Random()));
+    std::stable_sort(second.begin(), second.end(), by_pair);
+    const double h = 1e-3;
+    const auto resolve = [&](ContactResponse& response, const std::vector<Contact>& contacts, State& out,
+                             std::vector<Vec6>& pseudo) {
+      out = test_case.state;
+      bool has_pseudo = false;
+      pseudo.assign(model.count, Vec6::Zero());
+      return response.resolve(test_case.state, solver, contacts, h, out.velocity, out.angular, pseudo, has_pseudo);
+    };
+    ContactResponse cached(model), fresh(model);
+    State a, b;
+    std::vector<Vec6> pseudo_a, pseudo_b;
+    resolve(cached, first, a, pseudo_a);
+    const ContactStepReport report = resolve(cached, second, a, pseudo_a);
+    const ContactStepReport fresh_report = resolve(fresh, second, b, pseudo_b);
+    EXPECT_EQ(fresh_report.reused, 0);
+    EXPECT_EQ(report.reused, report.solved - (fresh_report.solved - static_cast<int>(first.size()) + 1))
+        << "seed " << seed << ": every kept contact of the first list is found again";
+    reused += report.reused;
+    for (int i = 1; i < model.count; ++i) {
+      EXPECT_TRUE(a.velocity[i] == b.velocity[i] && a.angular[i] == b.angular[i] && pseudo_a[i] == pseudo_b[i])
+          << "seed " << seed << " body " << i;
+    }
+    // A new factorization (here of the same pose) makes the last resolve's columns stale: none taken.
+    solver.factor(test_case.state);
+    EXPECT_EQ(resolve(cached, second, a, pseudo_a).reused, 0) << "seed " << seed;
+  }
+  EXPECT_GT(reused, 40);
+}
+
 // The contact pass (Simulation's step, after the joints' Newton corrections): when the joints' impulses
 // made the kept contacts approach again, correct() applies extra impulses. After it no contact
 // approaches, the joints still move together and no energy is added.
