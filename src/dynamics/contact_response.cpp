@@ -177,7 +177,9 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     bool marked = false;
     for (int k = 0; k <= l; ++k) {
       const int was_k = same_as_last_[static_cast<std::size_t>(k)];
-      if (was_k >= 0 && was_l >= 0 && was_k <= was_l) {
+      // (Two contacts matched to one, were the list to hold a contact twice, are computed: the last K's
+      // diagonal block is the transposed sum, not the same bits as the block between them.)
+      if (was_k >= 0 && was_l >= 0 && (was_k < was_l || k == l)) {
         K_.block<3, 3>(3 * k, 3 * l) = last_K_.block<3, 3>(3 * was_k, 3 * was_l);
         K_.block<3, 3>(3 * l, 3 * k) = last_K_.block<3, 3>(3 * was_l, 3 * was_k);
         continue;

@@ -858,6 +858,7 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
         contact_report.dropped = again.dropped;  // what the step leaves unsolved is the last list's
         contact_report.solves += again.solves;
         contact_report.solved += again.solved;
+        contact_report.reused += again.reused;
         contact_report.iterations += again.iterations;
         contact_report.active += again.active;
         contact_report.sticking += again.sticking;
