@@ -636,17 +636,44 @@ TEST(NarrowPhase, SegmentClosestPointsMatchAMinimisationAlongOneSegment) {
   EXPECT_LT(worst, 1e-12);
 }
 
+// piece_contact() against gjk_contact() on the same pieces: the same answer; when apart, a distance of
+// at least the margin, by which the returned normal separates the pieces (so a lower bound of their gap:
+// the gap along any direction is one), and, where GJK's own answer is exact for these pieces
+// (`gjk_exact`), at most GJK's. Counts the answers.
+struct AgainstGjk {
+  int apart = 0, in_contact = 0;
+  void check(const ConvexPiece& a, const Pose& pose_a, const ConvexPiece& b, const Pose& pose_b, double margin,
+             bool gjk_exact, int k) {
+    PieceContact mine, theirs;
+    const bool contact_here = piece_contact(a, pose_a, b, pose_b, margin, mine);
+    const bool contact_gjk = gjk_contact(a, pose_a, b, pose_b, margin, theirs);
+    ASSERT_EQ(contact_here, contact_gjk) << k;
+    if (contact_here) {
+      ++in_contact;
+      return;
+    }
+    ++apart;
+    EXPECT_GE(mine.distance, margin) << k;
+    if (gjk_exact) {
+      EXPECT_LE(mine.distance, theirs.distance + 1e-12) << k;
+    }
+    const Vec3& n = mine.normal;  // world, from b towards a
+    const double along_normal = pose_a.to_world(a.support(pose_a.rotation.transpose() * -n)).dot(n) -
+                                pose_b.to_world(b.support(pose_b.rotation.transpose() * n)).dot(n);
+    EXPECT_GE(along_normal, mine.distance - 1e-12) << k;  // coordinates of ~1 m: rounding
+  }
+};
+
 TEST(NarrowPhase, WirePairsSettledByTheirCapsulesGetGjksAnswer) {
   // Wire pairs that the side-to-side closed form declines (parallel threads, ends near wires) are
   // settled without GJK when their capsules are apart beyond the margin. The answer must be GJK's own
-  // (gjk_contact on the same pieces), and the distance left a lower bound of the wires' gap (GJK's,
-  // which is exact to a relative 1e-12 for the cores and certified for the wires whole). Pairs are placed
-  // so that their gaps straddle the margin (2 mm).
+  // (gjk_contact on the same pieces), and the distance left a lower bound of the wires' gap, at most
+  // GJK's (AgainstGjk). Pairs are placed so that their gaps straddle the margin (2 mm).
   std::mt19937 rng(43);
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double margin = 0.002;
-  int settled = 0, in_contact = 0;
+  AgainstGjk count;
   const Pose identity;
   for (int k = 0; k < 3000; ++k) {
     const Vec3 top(g(rng) * 0.01, 1, g(rng) * 0.01);
@@ -665,32 +692,21 @@ TEST(NarrowPhase, WirePairsSettledByTheirCapsulesGetGjksAnswer) {
       b = Wire{end + 0.04 * along, end, ra};
     }
     const ConvexPiece x = pieces_of(a)[0], y = pieces_of(b)[0];
-    PieceContact mine, theirs;
-    const bool contact_here = piece_contact(x, identity, y, identity, margin, mine);
-    const bool contact_gjk = gjk_contact(x, identity, y, identity, margin, theirs);
-    ASSERT_EQ(contact_here, contact_gjk) << k;
-    if (contact_here) {
-      ++in_contact;
-      continue;
-    }
-    ++settled;
-    EXPECT_GE(mine.distance, margin) << k;
-    EXPECT_LE(mine.distance, theirs.distance + 1e-12) << k;  // GJK's bound: at most the true gap
-    const double along_normal = x.support(-mine.normal).dot(mine.normal) - y.support(mine.normal).dot(mine.normal);
-    EXPECT_GE(along_normal, mine.distance - 1e-12) << k;  // the normal separates them by that much
+    // Both GJK answers are the capsules' (the cores') when apart: exact for them.
+    count.check(x, identity, y, identity, margin, true, k);
   }
-  std::printf("wire pairs: %d apart beyond the margin, %d in contact\n", settled, in_contact);
-  EXPECT_GT(settled, 500);
-  EXPECT_GT(in_contact, 500);
+  std::printf("wire pairs: %d apart beyond the margin, %d in contact\n", count.apart, count.in_contact);
+  EXPECT_GT(count.apart, 500);
+  EXPECT_GT(count.in_contact, 500);
 }
 
 TEST(NarrowPhase, PiecesApartAcrossAPlatesPlaneGetGjksAnswer) {
   // Pairs with a plate's part (a prism) are settled without GJK when they are apart beyond the margin
   // across the plate's plane. As for wires: the answer must be GJK's (gjk_contact on the same pieces),
-  // and the normal must separate the pieces by the distance left (so it is a lower bound of their gap:
-  // the gap along any direction is), which for a plate or a ball is at most the gap GJK measures. A vertical regular hexagon 2 mm thick (as the generator makes them) against a parallel
-  // plate, a tilted plate, a ball and a wire, placed 0-5 mm from it across its plane or beside its edge,
-  // both under a random rotation and shift; the margin is 2 mm.
+  // and the normal must separate the pieces by the distance left (AgainstGjk). A vertical regular hexagon
+  // 2 mm thick (as the generator makes them) against a parallel plate, a tilted plate, a ball and a wire,
+  // placed 0-5 mm from it across its plane or beside its edge, both under a random rotation and shift;
+  // the margin is 2 mm.
   std::mt19937 rng(47);
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -701,7 +717,7 @@ TEST(NarrowPhase, PiecesApartAcrossAPlatesPlaneGetGjksAnswer) {
   hexagon.v_axis = Vec3::UnitY();  // normal +z
   hexagon.thickness = 0.002;
   const ConvexPiece plate = pieces_of(hexagon)[0];
-  int apart = 0, in_contact = 0;
+  AgainstGjk count;
   for (int k = 0; k < 3000; ++k) {
     const double gap = 0.005 * u(rng);
     const bool beside_edge = (k / 4) % 3 == 2;  // beyond the rim, in the plate's plane: not across it
@@ -729,37 +745,18 @@ TEST(NarrowPhase, PiecesApartAcrossAPlatesPlaneGetGjksAnswer) {
       }
     }();
     const ConvexPiece piece = pieces_of(other)[0];
-    const auto random_pose = [&] {
-      Pose pose;
-      pose.rotation = Quat(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
-      pose.position = Vec3(g(rng), g(rng), g(rng));
-      return pose;
-    };
-    const Pose pose = random_pose();  // the same rigid motion for both: the gap stays as placed
+    Pose pose;  // the same rigid motion for both: the gap stays as placed
+    pose.rotation = Quat(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    pose.position = Vec3(g(rng), g(rng), g(rng));
     const bool plate_first = k % 2 == 0;
     const ConvexPiece& a = plate_first ? plate : piece;
     const ConvexPiece& b = plate_first ? piece : plate;
-    PieceContact mine, theirs;
-    const bool contact_here = piece_contact(a, pose, b, pose, margin, mine);
-    const bool contact_gjk = gjk_contact(a, pose, b, pose, margin, theirs);
-    ASSERT_EQ(contact_here, contact_gjk) << k;
-    if (contact_here) {
-      ++in_contact;
-      continue;
-    }
-    ++apart;
-    EXPECT_GE(mine.distance, margin) << k;
     // GJK's distance is exact for plates and balls; for a wire it is its capsule's, itself only a bound.
-    if (k % 4 != 3) {
-      EXPECT_LE(mine.distance, theirs.distance + 1e-12) << k;
-    }
-    const Vec3 na = pose.rotation.transpose() * mine.normal;  // the normal in the pieces' frame
-    const double along_normal = a.support(-na).dot(na) - b.support(na).dot(na);
-    EXPECT_GE(along_normal, mine.distance - 1e-12) << k;
+    count.check(a, pose, b, pose, margin, k % 4 != 3, k);
   }
-  std::printf("pairs with a plate: %d apart beyond the margin, %d in contact\n", apart, in_contact);
-  EXPECT_GT(apart, 500);
-  EXPECT_GT(in_contact, 500);
+  std::printf("pairs with a plate: %d apart beyond the margin, %d in contact\n", count.apart, count.in_contact);
+  EXPECT_GT(count.apart, 500);
+  EXPECT_GT(count.in_contact, 500);
 }
 
 }  // namespace
