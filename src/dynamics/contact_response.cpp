@@ -133,7 +133,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   // the same contacts is taken as it is (last_contacts_): the same numbers, bit for bit.
   std::swap(columns_, last_columns_);
   std::swap(K_, last_K_);
-  const bool same_factorization = have_last_ && solver.factorizations() == last_factorization_;
+  const bool same_factorization =
+      have_last_ && &solver == last_solver_ && solver.factorizations() == last_factorization_;
   same_as_last_.assign(static_cast<std::size_t>(m), -1);
   if (same_factorization) {
     // Both lists are sorted by (a, b) (the detector's order, kept by the kMaxContacts cut), so one merge.
@@ -198,6 +199,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   last_contacts_.assign(contacts.begin(), contacts.end());
   last_arm_a_.assign(arm_a_.begin(), arm_a_.begin() + m);
   last_arm_b_.assign(arm_b_.begin(), arm_b_.begin() + m);
+  last_solver_ = &solver;
   last_factorization_ = solver.factorizations();
   have_last_ = true;
 

@@ -24,6 +24,7 @@
 // that gains (the friction law's Gauss-Seidel need not converge on nearly dependent contacts), they are
 // recomputed without friction, and dropped for this step if that gains too.
 
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -137,14 +138,16 @@ class ContactResponse {
   std::vector<PathColumns> columns_;  // per contact, reused (no allocation once grown)
   std::vector<int> path_position_;    // per body: its index in one contact's columns_.node, or -1
   Eigen::MatrixXd K_;
-  // The last resolve's contacts, lever arms, path columns and K, and the solver factorization they were
-  // computed with (TreeSolver::factorizations): a contact of the next resolve identical to one of them
-  // (same components, point, normal and arms) at the same factorization has the same columns, and two
-  // such the same block of K. The look after a step's impulses finds most of the same contacts again.
+  // The last resolve's contacts, lever arms, path columns and K, and the solver and its factorization they
+  // were computed with (TreeSolver::factorizations): a contact of the next resolve identical to one of them
+  // (same components, point, normal and arms) at the same factorization of the same solver has the same
+  // columns, and two such the same block of K. The look after a step's impulses finds most of the same
+  // contacts again.
   std::vector<Contact> last_contacts_;
   std::vector<Vec3> last_arm_a_, last_arm_b_;
   std::vector<PathColumns> last_columns_;
   Eigen::MatrixXd last_K_;
+  const TreeSolver* last_solver_ = nullptr;
   std::uint64_t last_factorization_ = 0;
   bool have_last_ = false;
   std::vector<int> same_as_last_;  // per contact of this resolve: its index in the last one's, or -1

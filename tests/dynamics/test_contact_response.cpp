@@ -269,7 +269,7 @@ TEST(ContactResponse, MoreClosingContactsThanASolveTakesLeaveTheLatestAndAreCoun
 // then takes their columns of the collision matrix, and the blocks between them, from the resolve before
 // instead of computing them again. The result must be the same, bit for bit, as a fresh response's (which
 // computes everything) for a second list that drops one contact, keeps the others in order and adds new
-// ones; and nothing may be taken once the solver has factored again.
+// ones; and nothing may be taken from another solver, or once the solver has factored again.
 TEST(ContactResponse, ContactsFoundAgainAtTheSameFactorizationGiveTheSameResultBitForBit) {
   int reused = 0;
   for (unsigned seed = 1; seed <= 20; ++seed) {
@@ -308,6 +308,17 @@ TEST(ContactResponse, ContactsFoundAgainAtTheSameFactorizationGiveTheSameResultB
     // A new factorization (here of the same pose) makes the last resolve's columns stale: none taken.
     solver.factor(test_case.state);
     EXPECT_EQ(resolve(cached, second, a, pseudo_a).reused, 0) << "seed " << seed;
+    // Another solver, even one with as many factorizations, is not the one the columns came from.
+    TreeSolver other(model);
+    while (other.factorizations() < solver.factorizations()) other.factor(test_case.state);
+    ASSERT_EQ(other.factorizations(), solver.factorizations());
+    {
+      State c = test_case.state;
+      std::vector<Vec6> pseudo_c(model.count, Vec6::Zero());
+      bool has_pseudo = false;
+      EXPECT_EQ(cached.resolve(test_case.state, other, second, h, c.velocity, c.angular, pseudo_c, has_pseudo).reused, 0)
+          << "seed " << seed;
+    }
   }
   EXPECT_GT(reused, 40);
 }
