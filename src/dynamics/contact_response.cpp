@@ -169,7 +169,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     solver.eliminate_on_paths(c.a, on_a, c.b, on_b, columns_[k]);
   }
   // Column by column of blocks: contact l's path marked in path_position_, each block above the
-  // diagonal found by walking contact k's path alone (TreeSolver::coupling_indexed), or taken from the
+  // diagonal found by walking contact k's path alone (TreeSolver::coupling), or taken from the
   // last K where both contacts were there in the same order.
   K_.resize(3 * m, 3 * m);
   for (int l = 0; l < m; ++l) {
@@ -189,7 +189,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
         for (std::size_t q = 0; q < y.node.size(); ++q) path_position_[static_cast<std::size_t>(y.node[q])] = static_cast<int>(q);
         marked = true;
       }
-      const Mat3 block = TreeSolver::coupling_indexed(columns_[k], y, path_position_);
+      const Mat3 block = TreeSolver::coupling(columns_[k], y, path_position_);
       K_.block<3, 3>(3 * k, 3 * l) = block;
       K_.block<3, 3>(3 * l, 3 * k) = block.transpose();
     }

@@ -216,24 +216,7 @@ void TreeSolver::eliminate_on_paths(int body_a, const Mat63& wrench_a, int body_
   }
 }
 
-Mat3 TreeSolver::coupling(const PathColumns& x, const PathColumns& y) {
-  Mat3 out = Mat3::Zero();
-  std::size_t p = 0, q = 0;
-  while (p < x.node.size() && q < y.node.size()) {
-    if (x.node[p] > y.node[q]) {
-      ++p;
-    } else if (x.node[p] < y.node[q]) {
-      ++q;
-    } else {
-      out.noalias() += x.h[p].transpose() * y.e[q];
-      ++p;
-      ++q;
-    }
-  }
-  return out;
-}
-
-Mat3 TreeSolver::coupling_indexed(const PathColumns& x, const PathColumns& y, const std::vector<int>& position_in_y) {
+Mat3 TreeSolver::coupling(const PathColumns& x, const PathColumns& y, const std::vector<int>& position_in_y) {
   Mat3 out = Mat3::Zero();
   for (std::size_t p = 0; p < x.node.size(); ++p) {
     const int q = position_in_y[static_cast<std::size_t>(x.node[p])];

@@ -170,12 +170,10 @@ class TreeSolver {
                           PathColumns& out) const;
   // F1^T H^-1 F2 (the 3x3 block of velocity responses) for two eliminated column sets: column j of x's
   // wrenches against column i of y's gives entry (j, i). Symmetric: coupling(y, x) = coupling(x, y)^T.
-  static Mat3 coupling(const PathColumns& x, const PathColumns& y);
-  // The same sum, in the same order (x's nodes, decreasing: the same result bit for bit), with y's nodes
-  // looked up in `position_in_y` (indexed by body: the index of that body in y.node, or -1 where y's path
-  // does not pass): O(x's path) instead of a merge of both paths. For one y against many x, as the
-  // collision matrix's blocks are formed.
-  static Mat3 coupling_indexed(const PathColumns& x, const PathColumns& y, const std::vector<int>& position_in_y);
+  // Summed over x's nodes (decreasing), y's looked up in `position_in_y` (indexed by body: the index of
+  // that body in y.node, or -1 where y's path does not pass): O(x's path), for one y marked once against
+  // many x, as the collision matrix's blocks are formed.
+  static Mat3 coupling(const PathColumns& x, const PathColumns& y, const std::vector<int>& position_in_y);
 
   // World lever arms at the factored pose: centre of mass of body i -> joint i, and of parent -> joint i.
   const std::vector<Vec3>& child_arm() const { return child_arm_; }

@@ -284,19 +284,19 @@ TEST(ContactResponse, ContactsFoundAgainAtTheSameFactorizationGiveTheSameResultB
     second.push_back(approaching_contact(test_case.state, 1, 2, 0.1 * Vec3::Random(), Vec3::Random()));
     std::stable_sort(second.begin(), second.end(), by_pair);
     const double h = 1e-3;
-    const auto resolve = [&](ContactResponse& response, const std::vector<Contact>& contacts, State& out,
-                             std::vector<Vec6>& pseudo) {
+    const auto resolve = [&](ContactResponse& response, TreeSolver& with, const std::vector<Contact>& contacts,
+                             State& out, std::vector<Vec6>& pseudo) {
       out = test_case.state;
       bool has_pseudo = false;
       pseudo.assign(model.count, Vec6::Zero());
-      return response.resolve(test_case.state, solver, contacts, h, out.velocity, out.angular, pseudo, has_pseudo);
+      return response.resolve(test_case.state, with, contacts, h, out.velocity, out.angular, pseudo, has_pseudo);
     };
     ContactResponse cached(model), fresh(model);
     State a, b;
     std::vector<Vec6> pseudo_a, pseudo_b;
-    resolve(cached, first, a, pseudo_a);
-    const ContactStepReport report = resolve(cached, second, a, pseudo_a);
-    const ContactStepReport fresh_report = resolve(fresh, second, b, pseudo_b);
+    resolve(cached, solver, first, a, pseudo_a);
+    const ContactStepReport report = resolve(cached, solver, second, a, pseudo_a);
+    const ContactStepReport fresh_report = resolve(fresh, solver, second, b, pseudo_b);
     // Every contact is kept (each approaches at distance 0), so the first list's, less the one dropped,
     // are all found again.
     ASSERT_EQ(fresh_report.solved, static_cast<int>(second.size())) << "seed " << seed;
@@ -309,18 +309,12 @@ TEST(ContactResponse, ContactsFoundAgainAtTheSameFactorizationGiveTheSameResultB
     }
     // A new factorization (here of the same pose) makes the last resolve's columns stale: none taken.
     solver.factor(test_case.state);
-    EXPECT_EQ(resolve(cached, second, a, pseudo_a).reused, 0) << "seed " << seed;
+    EXPECT_EQ(resolve(cached, solver, second, a, pseudo_a).reused, 0) << "seed " << seed;
     // Another solver, even one with as many factorizations, is not the one the columns came from.
     TreeSolver other(model);
     while (other.factorizations() < solver.factorizations()) other.factor(test_case.state);
     ASSERT_EQ(other.factorizations(), solver.factorizations());
-    {
-      State c = test_case.state;
-      std::vector<Vec6> pseudo_c(model.count, Vec6::Zero());
-      bool has_pseudo = false;
-      EXPECT_EQ(cached.resolve(test_case.state, other, second, h, c.velocity, c.angular, pseudo_c, has_pseudo).reused, 0)
-          << "seed " << seed;
-    }
+    EXPECT_EQ(resolve(cached, other, second, a, pseudo_a).reused, 0) << "seed " << seed;
   }
   EXPECT_GT(reused, 40);
 }
