@@ -352,20 +352,45 @@ double fastest_turn_speed(const Quat& orientation, const Vec3& w, const Vec3& lo
 }  // namespace
 
 // With collisions on: whether every pair of components in contact turns at most kOldTurnLimit in a step
-// of h at these angular velocities. The drift-error rule alone lets a fast spinner turn up to kMaxTurn (4
-// times more); a component a knock sends spinning, or that the joints' corrections speed up after
-// detection, then sweeps past the contacts found at the start of the step: on the Steel Fish shaken hard,
-// overlaps of 9-18 mm within 80 s with the drift-error rule alone, none above 0.4 micrometres in 120 s
-// with this limit too. (It also keeps contact_deepening_bound's second-order terms small.) A component in
+// of h at these angular velocities (save about a component's axis of least moment, below). The
+// drift-error rule alone lets a fast spinner turn up to kMaxTurn (4 times more); a component a knock sends
+// spinning, or that the joints' corrections speed up after detection, then sweeps past the contacts found
+// at the start of the step: on the Steel Fish shaken hard, overlaps of 9-18 mm within 80 s with the
+// drift-error rule alone, none above 0.4 micrometres in 120 s with this limit too. (It also keeps
+// contact_deepening_bound's second-order terms small; that bound holds up to kMaxTurn as well, test
+// ContactTravel.BoundsTheOverlapAfterTheDriftOfTheFastestTurnAStepTakes.) A component in
 // no contact needs no such limit: the detection margin, h (|v| + |w| reach), covers its whole sweep, so
 // anything it could reach in the step is a contact of its own. (Until 2026-11-24 the limit held for every
 // component: generated-1023, 5000 steps from the swinging state, 1.62 -> 1.56 halvings per step without
-// it for the components in no contact.) Always true for the shortest step the subdivision allows (it must
-// make progress).
+// it for the components in no contact.) A turn about the axis a slender component lies along (its
+// principal axis of least moment) moves nothing of a wire on that axis but its surface, about itself: so
+// the limit is on the rest of the turn, h |w - (w . a) a| <= kOldTurnLimit, where the turn about the axis
+// moves the pieces in contact little, h |w . a| rho <= kMaxContactTravel, rho the farthest corner of the
+// box around their near part (Contact::near_low_a ...) from the axis. Those spins are what the limit
+// halved at generated-8191: light wires (moments 6e-11 against 2e-8 kg m^2) turning 0.06-0.1 rad per step
+// about their axes and 0.01-0.03 across them: this lets 111 of the 147 rejections of `aloft_step_profile
+// 8191 2000 1 swinging:7` through (259 of 326 for seed 1; docs/performance.md, "2026-12-05, night").
+// Always true for the shortest step the subdivision allows (it must make progress).
 bool Simulation::contacts_turn_slowly_enough(double h, const std::vector<Vec3>& angular) const {
   if (at_finest_step(h)) return true;
+  // Component i of a contact, with the box (principal frame, m; empty when not known) around its near part.
+  const auto turns_slowly = [&](int i, const Vec3& near_low, const Vec3& near_high) {
+    if (i == 0 || h * angular[i].norm() <= kOldTurnLimit) return true;
+    if (!(near_low.x() <= near_high.x())) return false;
+    int axis = 0;  // of least moment
+    const Vec3& moments = model_.principal_moments[i];
+    for (int k = 1; k < 3; ++k)
+      if (moments[k] < moments[axis]) axis = k;
+    const Vec3 w = state_.orientation[i].conjugate() * angular[i];  // principal frame
+    const double about_axis = w[axis];
+    if (!(h * std::hypot(w[(axis + 1) % 3], w[(axis + 2) % 3]) <= kOldTurnLimit)) return false;
+    // The box's farthest corner from the axis: its extent across it.
+    const auto farthest = [&](int k) { return std::max(std::abs(near_low[k]), std::abs(near_high[k])); };
+    const double rho = std::hypot(farthest((axis + 1) % 3), farthest((axis + 2) % 3));
+    return h * std::abs(about_axis) * rho <= kMaxContactTravel;
+  };
   for (const Contact& c : work_->contacts)
-    if (!(c.a == 0 || h * angular[c.a].norm() <= kOldTurnLimit) || !(h * angular[c.b].norm() <= kOldTurnLimit))
+    if (!turns_slowly(c.a, c.near_low_a, c.near_high_a) || !turns_slowly(c.b, c.near_low_b, c.near_high_b))
       return false;
   return true;
 }

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "aloft/collision.hpp"
 #include "aloft/generate.hpp"
@@ -244,6 +246,59 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
               2 * cycles, stats.impulses, stats.sliding, stats.deepest * 1e3, worst_left_overlap * 1e3,
               stats.energy_removed, worst_gain);
   std::printf("  deepest overlap at a step's start %.3f of the thinnest half-width near it\n", worst_relative_overlap);
+}
+
+// A thread (0.4 m of 1 mm steel wire) hanging from the hook beside a second one, 0.5 mm apart: spun about
+// its own (vertical) axis at 150 rad/s, it turns 0.15 rad in a 1 ms step, three times kOldTurnLimit, but
+// its near part, the length of thread beside the other, turns in place: the pair's contact is the same
+// at the step's end. With `bar`, a 10 cm crossbar at the spinner's foot, and the other thread beside the
+// crossbar's end instead: the same spin sweeps that end past the thread at 7.5 m/s, and the step must be
+// shortened (Simulation::contacts_turn_slowly_enough).
+std::string spinning_thread(bool bar) {
+  // The other thread's axis: its surface 0.5 mm from the spinning thread's, or 1 mm from the crossbar's end.
+  const std::string x = bar ? "0.0515" : "0.0015";
+  std::string json = R"({"name": "spinning thread", "contact": {"restitution": 0.5, "friction": 0.3},
+  "components": [
+    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.01, 1, 0], "to": [0.06, 1, 0], "radius": 0.003}}]},
+    {"name": "spinner", "parent": "hook", "joint": [0, 1, 0], "shapes": [
+      {"wire": {"from": [0, 1, 0], "to": [0, 0.6, 0], "radius": 0.0005}})";
+  if (bar) json += R"(, {"wire": {"from": [-0.05, 0.6, 0], "to": [0.05, 0.6, 0], "radius": 0.0005}})";
+  json += R"(]},
+    {"name": "other", "parent": "hook", "joint": [X, 1, 0], "shapes": [
+      {"wire": {"from": [X, 1, 0], "to": [X, 0.55, 0], "radius": 0.0005}}]}]})";
+  for (std::size_t at = json.find('X'); at != std::string::npos; at = json.find('X')) json.replace(at, 1, x);
+  return json;
+}
+
+TEST(Collisions, AThreadSpinningAboutItsOwnAxisBesideAnotherKeepsItsStep) {
+  for (const bool bar : {false, true}) {
+    const Model model = model_from(spinning_thread(bar));
+    Simulation sim(model);
+    sim.mutable_state().angular[1] = Vec3(0, 150, 0);  // rad/s, about the thread's axis (a principal axis)
+    for (int step = 0; step < 20; ++step) ASSERT_TRUE(sim.step()) << sim.failure()->message;
+    const StepStatistics& stats = sim.step_statistics();
+    const double spin = sim.state().angular[1].y();
+    std::printf("%s: %lld (sub)steps taken for 20 steps, %lld rejected for a pair in contact turning too fast; "
+                "spin %.3f rad/s, deepest overlap %.3g mm\n",
+                bar ? "crossbar" : "thread", stats.accepted, stats.rejected_contact_turn, spin,
+                sim.collision_statistics().deepest * 1e3);
+    // The pair is within the detection margin (the spin's sweep, h |w| times the spinner's reach, widens
+    // it), so the rule is asked.
+    EXPECT_GT(sim.collision_statistics().steps_with_contacts, 0) << (bar ? "crossbar" : "thread");
+    if (bar) {
+      // The crossbar's end turns across itself: the steps it passes the other thread in are divided (to
+      // 0.25 ms, where it turns 0.0375 rad; measured: 46 (sub)steps for the 20 steps, 5 rejected).
+      EXPECT_GT(stats.rejected_contact_turn, 0);
+      EXPECT_GT(stats.accepted, 20);
+    } else {
+      // Every step taken whole: the thread's spin moves its surface by 0.075 mm per step, its axis not at all.
+      EXPECT_EQ(stats.rejected_contact_turn, 0);
+      EXPECT_EQ(stats.accepted, 20);
+    }
+    // Nothing touched: no overlap, and the spin kept (a spin about a principal axis, no impulse).
+    EXPECT_EQ(sim.collision_statistics().deepest, 0.0);
+    EXPECT_NEAR(spin, 150.0, 1e-6);
+  }
 }
 
 // A crowded mobile: the generated 1023-component one (seed 1), set knocking by `aloft bench`'s breeze

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "dynamics/contact_travel.hpp"
@@ -147,39 +148,64 @@ double overlap_after(const Scene& s, double h) {
   return std::min(overlap_along(a, b, n_b), overlap_along(a, b, n_a));
 }
 
-TEST(ContactTravel, BoundsTheOverlapAfterTheDrift) {
-  // Speeds up to 2 m/s and spins up to 50 rad/s: Simulation lets no component in a step of 1 ms turn
-  // more than kOldTurnLimit = 0.05 rad; knocked pieces of the generated mobiles move at up to 1.5 m/s.
-  // Gaps from 0.3 mm of overlap to 0.6 mm apart (the detection margin and the penetration seen).
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> gap(-3e-4, 6e-4);
-  double worst_excess = -INFINITY, tightest = 0;
+// 20000 random scenes, a moving at up to 2 m/s and spinning at up to `spin_a` (rad/s), b (fixed in every
+// fourth) at up to 1 m/s and `spin_b`: the overlap after the drift never exceeds the bound. Returns how
+// many trials deepened (by more than 1 micrometre) and the largest deepening over its bound.
+struct BoundProbe {
   int deepened = 0;
+  double tightest = 0;
+};
+BoundProbe probe_bound(unsigned seed, double spin_a, double spin_b) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> gap(-3e-4, 6e-4);
+  BoundProbe probe;
+  double worst_excess = -INFINITY;
   for (int trial = 0; trial < 20000; ++trial) {
     Scene s = make_scene(rng, gap(rng));
-    set_random_motion(rng, s.a, 2.0, 50.0);
-    set_random_motion(rng, s.b, trial % 4 == 0 ? 0.0 : 1.0, trial % 4 == 0 ? 0.0 : 30.0);  // b sometimes fixed
+    set_random_motion(rng, s.a, 2.0, spin_a);
+    set_random_motion(rng, s.b, trial % 4 == 0 ? 0.0 : 1.0, trial % 4 == 0 ? 0.0 : spin_b);  // b sometimes fixed
     const double before = overlap_along(s.a, s.b, s.contact.normal);
-    ASSERT_NEAR(before, -s.contact.distance, 1e-12) << "the scene's gap, trial " << trial;
+    EXPECT_NEAR(before, -s.contact.distance, 1e-12) << "the scene's gap, trial " << trial;
     const double bound = contact_deepening_bound(s.contact, s.a.side(), s.b.side(), kStep, true);
     const double after = overlap_after(s, kStep);
     // The claim: no deeper than max(0, -d) + bound. Rounding: positions of order 1 m, 1e-15 m.
     const double excess = after - (std::max(0.0, -s.contact.distance) + bound);
-    ASSERT_LE(excess, 1e-12) << "trial " << trial << ": overlap " << after << " m after, distance "
+    EXPECT_LE(excess, 1e-12) << "trial " << trial << ": overlap " << after << " m after, distance "
                              << s.contact.distance << " m before, bound " << bound << " m";
+    if (excess > 1e-12) break;
     worst_excess = std::max(worst_excess, excess);
     if (after > std::max(0.0, -s.contact.distance) + 1e-6) {
-      ++deepened;
-      tightest = std::max(tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
+      ++probe.deepened;
+      probe.tightest = std::max(probe.tightest, (after - std::max(0.0, -s.contact.distance)) / bound);
     }
   }
+  std::printf("spins up to %g and %g rad/s: deepened %d of 20000; largest deepening / bound %.3f; closest "
+              "approach to the bound %.3g m\n", spin_a, spin_b, probe.deepened, probe.tightest, worst_excess);
+  return probe;
+}
+
+TEST(ContactTravel, BoundsTheOverlapAfterTheDrift) {
+  // Speeds up to 2 m/s and spins up to 50 rad/s: Simulation lets no component in contact turn more than
+  // kOldTurnLimit = 0.05 rad in a step of 1 ms, save about an axis its near part lies along (below);
+  // knocked pieces of the generated mobiles move at up to 1.5 m/s. Gaps from 0.3 mm of overlap to 0.6 mm
+  // apart (the detection margin and the penetration seen).
+  const BoundProbe probe = probe_bound(5, 50.0, 30.0);
   // The test must probe the bound, not pass far below it: many trials deepen, and the deepest comes near
   // the bound (the approach, the gap and the turn are taken to first order exactly; the curvature
   // allowance is generous, not loose). Measured: 7923 trials deepen, the largest by 1.000 of the bound.
-  EXPECT_GT(deepened, 2000);
-  EXPECT_GT(tightest, 0.9);
-  std::printf("deepened %d of 20000; largest deepening / bound %.3f; closest approach to the bound %.3g m\n",
-              deepened, tightest, worst_excess);
+  EXPECT_GT(probe.deepened, 2000);
+  EXPECT_GT(probe.tightest, 0.9);
+}
+
+TEST(ContactTravel, BoundsTheOverlapAfterTheDriftOfTheFastestTurnAStepTakes) {
+  // A component in contact may turn faster than kOldTurnLimit when its near part turns little (a wire
+  // spinning about its own axis: Simulation::contacts_turn_slowly_enough); the step-size rule still holds
+  // every body to kMaxTurn = 0.2 rad per step, 200 rad/s at 1 ms. The bound must hold up to there too,
+  // where its second-order allowances are 16 times what they are at 50 rad/s. Measured: 8897 trials
+  // deepen, the largest by 0.999 of the bound.
+  const BoundProbe probe = probe_bound(6, 200.0, 200.0);
+  EXPECT_GT(probe.deepened, 2000);
+  EXPECT_GT(probe.tightest, 0.9);
 }
 
 TEST(ContactTravel, ATranslationCountsOnlyItsApproach) {

@@ -214,13 +214,16 @@ TEST(SparseCorrections, ContactPassesDriftOnlyWhatTheirImpulsesMoveAndEndWhereFu
   EXPECT_LE(widest_gap, std::sqrt(3.0) * tolerance);
   // A pass leaves a skipped subtree's joint point at most half the tolerance (per coordinate) from where the
   // full pass puts it, and the Newton corrections then close the joints to the tolerance either way: a
-  // step's end differs from the full one's by a few halves of the tolerance (measured: median 0.73; the
-  // sparse corrections alone, against full ones, 0.52 over 100 such steps). The largest is not bounded
-  // here: now and then the contact law's iterations, started from velocities that differ in the last
-  // digits, end on another active set, and the step with them (measured up to 62 tolerances). What the
-  // median catches: 28 tolerances when a pass gave its bodies half their linear velocity change, 11 with
-  // a skip threshold 100 times too large.
-  EXPECT_LE(median, 2.0);
+  // step's end differs from the full one's by a few halves of the tolerance (measured: median 2.16 after
+  // the 1 s of breeze here; 0.95-2.16 after 0.5-1.6 s, twelve starts 0.1 s apart, and 0.43-1.99 for the
+  // same starts before 2026-12-05, when a component in contact spinning about its own axis still halved
+  // the step: the light bars of the knocked mobile are the bodies furthest apart; the sparse corrections
+  // alone, against full ones, 0.52 over 100 such steps). The largest is not bounded here: now and then
+  // the contact law's iterations, started from velocities that differ in the last digits, end on another
+  // active set, and the step with them (measured up to 1480 tolerances, 0.15 mm). What the median
+  // catches: 28 tolerances when a pass gave its bodies half their linear velocity change, 11 with a skip
+  // threshold 100 times too large; the bound sits above the spread of the starts measured, below both.
+  EXPECT_LE(median, 3.0);
 }
 
 }  // namespace
