@@ -137,6 +137,16 @@ struct CollisionDetector::Impl {
   std::vector<int> stale;          // update_list's: the components to list again
   std::vector<char> is_stale;      // relist's: by component, whether in `stale` (all 0 between calls)
   std::vector<Vec3> piece_center;  // world centres of a's pieces for the current pair
+  // The pieces' enclosing spheres, all components' in one array (component i's are
+  // sphere[first_sphere[i]] to sphere[first_sphere[i + 1]], in piece order): the narrow phase's first
+  // test reads only these. (Read from the pieces themselves, each component's in its own allocation,
+  // the loads missed the cache: perf on generated-8191 put 58 % of narrow()'s own time on them.)
+  struct PieceSphere {
+    Vec3 center;    // body frame, m
+    double radius;  // m
+  };
+  std::vector<PieceSphere> sphere;
+  std::vector<std::uint32_t> first_sphere;
   struct Found {
     PieceContact contact;
     const ConvexPiece *piece_a, *piece_b;
@@ -145,7 +155,14 @@ struct CollisionDetector::Impl {
   std::vector<Found> found;
 
   Impl(const Model& model, std::vector<ComponentGeometry> g)
-      : geometry(std::move(g)), filter(model, geometry), pairs(internal::prune_pairs(model, geometry, filter)) {}
+      : geometry(std::move(g)), filter(model, geometry), pairs(internal::prune_pairs(model, geometry, filter)) {
+    first_sphere.reserve(geometry.size() + 1);
+    for (const ComponentGeometry& component : geometry) {
+      first_sphere.push_back(static_cast<std::uint32_t>(sphere.size()));
+      for (const ConvexPiece& piece : component.pieces) sphere.push_back({piece.bound_center, piece.bound_radius});
+    }
+    first_sphere.push_back(static_cast<std::uint32_t>(sphere.size()));
+  }
 
   bool is_candidate(int a, int b) const {
     return !filter.joined(a, b) && filter.may_touch(a, b) &&
@@ -286,20 +303,21 @@ struct CollisionDetector::Impl {
   // The contacts of a pair of the list, and its piece pairs' distance bounds brought up to date.
   void narrow(CandidatePair& pair, std::vector<Contact>& contacts) {
     const int a = pair.a, b = pair.b;
-    const ComponentGeometry &ga = geometry[a], &gb = geometry[b];
     const double pair_margin = margin[a] + margin[b];
-    piece_center.resize(ga.pieces.size());
-    for (std::size_t k = 0; k < ga.pieces.size(); ++k) piece_center[k] = pose[a].to_world(ga.pieces[k].bound_center);
+    const PieceSphere* sphere_a = sphere.data() + first_sphere[a];
+    const PieceSphere* sphere_b = sphere.data() + first_sphere[b];
+    const std::size_t pieces_a = first_sphere[a + 1] - first_sphere[a];
+    const std::size_t pieces_b = first_sphere[b + 1] - first_sphere[b];
+    piece_center.resize(pieces_a);
+    for (std::size_t k = 0; k < pieces_a; ++k) piece_center[k] = pose[a].to_world(sphere_a[k].center);
     found.clear();
     PieceContact c;
     double lower = INFINITY;  // the least lower bound of the piece pairs' distances, now
     DistanceBound* bound = bounds.data() + pair.bounds;
-    for (std::size_t l = 0; l < gb.pieces.size(); ++l) {
-      const ConvexPiece& y = gb.pieces[l];
-      const Vec3 cy = pose[b].to_world(y.bound_center);
-      for (std::size_t k = 0; k < ga.pieces.size(); ++k, ++bound) {
-        const ConvexPiece& x = ga.pieces[k];
-        const double spheres = (piece_center[k] - cy).norm() - x.bound_radius - y.bound_radius;
+    for (std::size_t l = 0; l < pieces_b; ++l) {
+      const Vec3 cy = pose[b].to_world(sphere_b[l].center);
+      for (std::size_t k = 0; k < pieces_a; ++k, ++bound) {
+        const double spheres = (piece_center[k] - cy).norm() - sphere_a[k].radius - sphere_b[l].radius;
         if (spheres > pair_margin) {
           lower = std::min(lower, spheres - kCoherenceRelativeSlack * spheres - kCoherenceSlack);
           continue;
@@ -312,6 +330,7 @@ struct CollisionDetector::Impl {
             continue;
           }
         }
+        const ConvexPiece &x = geometry[a].pieces[k], &y = geometry[b].pieces[l];
         if (internal::piece_contact(x, pose[a], y, pose[b], pair_margin, c)) {
           found.push_back({c, &x, &y, static_cast<int>(found.size())});
           bound->distance = -INFINITY;
