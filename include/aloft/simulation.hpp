@@ -96,7 +96,7 @@ struct StepStatistics {
   long long pushes = 0;          // (sub)steps that pushed overlapping pieces apart
 };
 
-struct StepWorkspace;  // solver factorization and scratch (dynamics/simulation.cpp)
+struct StepWorkspace;  // solver factorization and scratch (dynamics/step_workspace.hpp)
 struct ContactStepReport;  // what the contact stage did in one step (dynamics/contact_response.hpp)
 
 class Simulation {
@@ -137,9 +137,10 @@ class Simulation {
   void set_joint_tolerance(double metres) { fixed_joint_tolerance_ = metres; }
   // Whether a Newton correction that follows a pass leaving few joints open solves for those joints
   // alone and visits only the bodies it moves, and a contact pass after such a pass drifts again only
-  // the bodies its impulses move (on by default; simulation.cpp, kSparseRowsPer and contact_pass_drift).
-  // Off, every correction and contact pass is a full solve and drift: for tests and measurements.
-  // Mobiles of fewer than 64 bodies, or whose bodies are not in depth-first order, always take full ones.
+  // the bodies its impulses move (on by default; dynamics/step_workspace.hpp, kSparseRowsPer, and
+  // dynamics/drift_passes.cpp). Off, every correction and contact pass is a full solve and drift: for
+  // tests and measurements. Mobiles of fewer than 64 bodies, or whose bodies are not in depth-first
+  // order, always take full ones.
   void set_sparse_corrections(bool on);
 
   // Air damping rates (1/s); default from the model.
@@ -172,7 +173,7 @@ class Simulation {
   bool contacts_turn_slowly_enough(double h, const std::vector<Vec3>& angular) const;
   bool contacts_move_slowly_enough(double h, bool pushed) const;
   bool advance_by(double h, int depth);
-  // rattle()'s drift (see simulation.cpp): a plain pass, and a Newton correction of the half-step
+  // rattle()'s drift (dynamics/drift_passes.cpp): a plain pass, and a Newton correction of the half-step
   // velocities or of the pseudo-velocities followed by a pass.
   enum class DriftCorrection { kVelocity, kPseudo };
   double drift_pass(double h, bool first_of_step, bool with_pseudo);
