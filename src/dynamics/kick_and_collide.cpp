@@ -6,7 +6,6 @@
 #include <cmath>
 
 #include "common/cpu_dispatch.hpp"
-#include "dynamics/rotation.hpp"
 #include "dynamics/step_workspace.hpp"
 
 namespace aloft {

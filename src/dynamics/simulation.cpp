@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/cpu_dispatch.hpp"
 #include "dynamics/step_workspace.hpp"
 
 namespace aloft {

@@ -1,7 +1,8 @@
-// Sparse Newton corrections (dynamics/step_workspace.hpp, kSparseRowsPer): once a pass leaves few joints open, the next
-// correction solves for those joints alone and visits only the bodies it moves. Each step must still close
-// every joint to the tolerance, and the motion must be the full corrections' up to what the tolerance
-// itself allows. The contact passes go sparse the same way (Simulation::contact_pass_drift): tested last.
+// Sparse Newton corrections (dynamics/step_workspace.hpp, kSparseRowsPer): once a pass leaves few joints
+// open, the next correction solves for those joints alone and visits only the bodies it moves. Each step
+// must still close every joint to the tolerance, and the motion must be the full corrections' up to what
+// the tolerance itself allows. The contact passes go sparse the same way (Simulation::contact_pass_drift):
+// tested last.
 #include <gtest/gtest.h>
 
 #include <algorithm>
