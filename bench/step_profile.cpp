@@ -8,7 +8,8 @@
 //   aloft_step_profile [--every N] MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
 //     --every N: also print, after every N steps, the same figures for those N steps alone (how a run's
 //       cost changes along it: a generated mobile with collisions tangles, and its late steps cost many
-//       times its early ones; docs/performance.md)
+//       times its early ones; docs/performance.md), with the energy, the fastest spin and the deepest
+//       overlap at the block's end
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
 //     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
 //       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
@@ -40,6 +41,7 @@
 
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
+#include "aloft/state.hpp"
 #include "bench_models.hpp"
 
 namespace {
@@ -187,8 +189,21 @@ int main(int argc, char** argv) {
       const double block_seconds = thread_seconds() - start;
       seconds += block_seconds;
       if (every > 0) {
-        std::printf("steps %ld-%ld: %.1f us/step, %.3f halvings per step\n", done, done + block,
-                    1e6 * block_seconds / block, static_cast<double>(sim.subdivisions() - block_halvings) / block);
+        // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping
+        // and knocks; it must never grow), the fastest spin (what the step-size rule halves the step for:
+        // on the large generated mobiles, light bars whirled about their pivots by knocks), and the
+        // deepest overlap a step has started from so far.
+        const State& now = sim.state();
+        int fastest = 1;
+        for (int i = 2; i < model.count; ++i)
+          if (now.angular[i].squaredNorm() > now.angular[fastest].squaredNorm()) fastest = i;
+        const double kinetic = kinetic_energy(model, now);
+        std::printf("steps %ld-%ld: %.1f us/step, %.3f halvings per step; then energy %.6f J (kinetic %.6f), "
+                    "fastest spin %.1f rad/s ('%s', %.3g kg), deepest overlap so far %.3g mm\n",
+                    done, done + block, 1e6 * block_seconds / block,
+                    static_cast<double>(sim.subdivisions() - block_halvings) / block,
+                    kinetic + potential_energy(model, now), kinetic, now.angular[fastest].norm(),
+                    model.names[fastest].c_str(), model.mass[fastest], 1e3 * sim.collision_statistics().deepest);
         print_rates("    ", block_start, counts_of(sim), block);
         std::fflush(stdout);
       }
