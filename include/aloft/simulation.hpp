@@ -64,6 +64,11 @@ struct CollisionStatistics {
   long long contacts_left = 0;
   double energy_removed = 0;          // J of kinetic energy the impulses took out (>= 0)
   double deepest = 0;                 // m, largest overlap seen at the start of a step
+  // The largest overlap seen at the start of a step as a fraction of the smallest half-width of its
+  // pair's pieces near the contact (Contact::thinnest: a wire's radius, half a plate's thickness). At 1
+  // a piece would be reached to its middle, where the narrow phase could read the overlap from the far
+  // side and the push drive it through; the step's checks keep it well below (contact_checks.cpp).
+  double deepest_relative = 0;
 };
 
 // Running totals of how the (sub)steps were taken since the simulation started: what they cost and why

@@ -124,6 +124,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     u_.segment<3>(3 * k) = basis_[k].transpose() * relative_velocity(c, arm_a_[k], arm_b_[k], velocity, angular);
     rows_[k].friction = 0.5 * (model_.friction[c.a] + model_.friction[c.b]);
     report.deepest = std::max(report.deepest, -c.distance);
+    report.deepest_relative = std::max(report.deepest_relative, -c.distance / c.thinnest);
   }
 
   // The collision matrix K = G H^-1 G^T from path-sparse columns: each contact's three unit impulses

@@ -70,6 +70,7 @@ struct ContactStepReport {
                                      // that gained too
   double energy_change = 0;    // J, kinetic energy the impulses changed (<= 0 up to round-off)
   double deepest = 0;          // m, largest overlap among the contacts (>= 0)
+  double deepest_relative = 0; // the largest overlap over its contact's Contact::thinnest (>= 0)
 };
 
 class ContactResponse {

@@ -173,6 +173,7 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
         contact_report.frictionless = std::max(contact_report.frictionless, again.frictionless);
         contact_report.energy_change += again.energy_change;
         contact_report.deepest = std::max(contact_report.deepest, again.deepest);
+        contact_report.deepest_relative = std::max(contact_report.deepest_relative, again.deepest_relative);
       }
     }
     // The step-size rule once more, on the velocities the contact impulses made. (The contacts' list may

@@ -304,6 +304,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.contacts_left += contact_report.dropped;
     stats.energy_removed -= std::min(0.0, contact_report.energy_change);
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
+    stats.deepest_relative = std::max(stats.deepest_relative, contact_report.deepest_relative);
   }
   return true;
 }
