@@ -16,9 +16,9 @@ namespace {
 
 // A step with collisions on is accepted (contacts_move_slowly_enough) when, for every contact, either
 // the pieces can get at most kDeepeningPerHalfWidth times the thinnest one's half-width (and at most
-// kMaxContactTravel) deeper into each other (contact_deepening_bound), or no point of them travels more
-// than kMaxContactTravel, or, where neither holds, the pair's motion through the step, sampled
-// (sweep_contact), takes it no deeper than the first allows.
+// kMaxContactTravel) deeper into each other (contact_deepening_bound), or the two sides' travels (how far
+// any point of each one's pieces moves) add up to no more than that, or, where neither holds, the pair's
+// motion through the step, sampled (sweep_contact), takes it no deeper than the first allows.
 //  - kMaxContactTravel (m): a third of the thinnest sheet of the presets (1.5 mm). Measured on the Steel
 //    Fish shaken hard for 600 s: with no such limit, pieces knocked at 2-5 m/s overlapped by up to 4.2 mm
 //    within a step; with 0.5 mm, by less than a micrometre (1 mm still let 1.5 mm through). (Since then,
@@ -128,8 +128,8 @@ bool Simulation::contacts_turn_slowly_enough(double h, const std::vector<Vec3>& 
 // step; a plate edge sweeping several millimetres per step past a 2 mm wire can pierce it away from that
 // point before the next step sees it. Every pair in contact must turn little
 // (contacts_turn_slowly_enough), and each contact must either
-//   - travel little: no point of the near parts of its pieces (Contact::near_low_a ...) moves more than
-//     kMaxContactTravel, or
+//   - travel little: the farthest any point of the near parts of a's pieces (Contact::near_low_a ...)
+//     moves and the farthest any of b's does add up to no more than the deepening allowed below, or
 //   - deepen little: its pieces can get at most kDeepeningPerHalfWidth of the thinnest one's half-width
 //     (and at most kMaxContactTravel) deeper into each other (contact_deepening_bound), or, where neither
 //     bound does for some contact of a pair,
@@ -174,37 +174,45 @@ bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
     s.near_high = high;
     return s;
   };
-  // How far any point of the pieces in contact travels, from the speed of their fastest point: at most
-  // |v| + |w| times the pieces' reach from the centre of mass, and at most the fastest corner of the box
-  // around them, |v + w x corner| (sharper for a piece turning about an axis through or near it, as a
-  // plate spinning on its thread; to first order in the turn). Any other piece of the pair that could come
-  // near within the step is within the detection margin, which the component's whole reach sets, so it is
-  // a contact of its own, checked here too.
-  const auto travels_little = [&](const Contact& c) {
-    for (int k = 0; k < 2; ++k) {
-      const int i = k == 0 ? c.a : c.b;
-      if (i == 0) continue;
-      const Motion m = motion(i);
-      const double reach = std::min(work.detector->reach(i), k == 0 ? c.reach_a : c.reach_b);
-      const double turn = m.drift.norm() + m.push.norm();
-      if (h * (m.velocity.norm() + turn * reach) <= kMaxContactTravel) continue;
-      const Vec3& low = k == 0 ? c.near_low_a : c.near_low_b;
-      const Vec3& high = k == 0 ? c.near_high_a : c.near_high_b;
-      if (!(low.x() <= high.x()) ||
-          h * (fastest_corner_speed(state_.orientation[i], m.velocity, m.drift, low, high) +
-               m.push.norm() * farthest_corner(low, high)) > kMaxContactTravel)
-        return false;
-    }
-    return true;
+  // How far any point of one side's pieces in contact travels (m), from the speed of their fastest point:
+  // at most |v| + |w| times the pieces' reach from the centre of mass, and at most the fastest corner of
+  // the box around them, |v + w x corner| (sharper for a piece turning about an axis through or near it,
+  // as a plate spinning on its thread; to first order in the turn). Any other piece of the pair that could
+  // come near within the step is within the detection margin, which the component's whole reach sets, so
+  // it is a contact of its own, checked here too.
+  const auto travel = [&](const Contact& c, int k) {
+    const int i = k == 0 ? c.a : c.b;
+    if (i == 0) return 0.0;
+    const Motion m = motion(i);
+    const double reach = std::min(work.detector->reach(i), k == 0 ? c.reach_a : c.reach_b);
+    const double turn = m.drift.norm() + m.push.norm();
+    double far = h * (m.velocity.norm() + turn * reach);
+    const Vec3& low = k == 0 ? c.near_low_a : c.near_low_b;
+    const Vec3& high = k == 0 ? c.near_high_a : c.near_high_b;
+    if (low.x() <= high.x())
+      far = std::min(far, h * (fastest_corner_speed(state_.orientation[i], m.velocity, m.drift, low, high) +
+                               m.push.norm() * farthest_corner(low, high)));
+    return far;
   };
+  // What a contact may get deeper in one step (m): kDeepeningPerHalfWidth of its pieces' thinnest
+  // half-width, and at most kMaxContactTravel.
+  const auto allowed_deepening = [](const Contact& c) {
+    return std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
+  };
+  // The pieces can come closer by at most the sum of how far the two sides travel: when that is within
+  // what the contact may deepen, so is the deepening. (Until 2026-12-06 each side alone was held to
+  // kMaxContactTravel, which let the two come 2 kMaxContactTravel closer: 1 mm, against the generated
+  // mobiles' 0.5 mm threads. On generated-1023 after the breeze, a thread and its neighbour, 0.08 mm apart,
+  // met at 0.7 m/s within one step that both sides' travels allowed, and the next step began 0.62 mm deep:
+  // 1.25 times the thread's radius. docs/collisions.md, "How far pieces in contact may move per step".)
+  const auto travels_little = [&](const Contact& c) { return travel(c, 0) + travel(c, 1) <= allowed_deepening(c); };
   // The bound on how much deeper the pieces get, where it covers them all: every nearby piece pair of
   // the two components is a contact (c.complete), each within a known box.
   const auto deepens_little = [&](const Contact& c) {
     if (!c.complete || !(c.near_low_a.x() <= c.near_high_a.x()) || !(c.near_low_b.x() <= c.near_high_b.x()))
       return false;
-    const double allowed = std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
     return contact_deepening_bound(c, side(c.a, c.reach_a, c.near_low_a, c.near_high_a),
-                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, true) <= allowed;
+                                   side(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, true) <= allowed_deepening(c);
   };
   // The pair's motion as the step moved it, and how far any point of each near part moved: at most
   // h (|v| + max |w_m x r| + |w_p| |r|) over the near box's corners r (|w x r| is convex in r, and turning
@@ -239,7 +247,7 @@ bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
     }
     if (bounded) continue;
     const Contact& c = contacts[first];  // the pair's near boxes, reach and thinnest are the same in each
-    const double allowed = std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
+    const double allowed = allowed_deepening(c);
     const SweepResult sweep =
         sweep_contact(*work.detector, c.a, swept(c.a, c.reach_a, c.near_low_a, c.near_high_a), c.b,
                       swept(c.b, c.reach_b, c.near_low_b, c.near_high_b), h, start_overlap, allowed, c.thinnest);

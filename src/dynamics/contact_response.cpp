@@ -70,6 +70,24 @@ void ContactResponse::respond(const std::vector<Contact>& contacts, const Eigen:
   clear_wrenches(contacts);
 }
 
+// Contact c's gap (m) after two steps of h at its present normal approach speed (its gap now if it
+// separates), at the pose its arms are measured from.
+double ContactResponse::gap_after_two_steps_of(const Contact& c, const State& pose, double h,
+                                               const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) {
+  const double un = c.normal.dot(
+      relative_velocity(c, c.point - pose.position[c.a], c.point - pose.position[c.b], velocity, angular));
+  return c.distance + 2.0 * h * std::min(un, 0.0);
+}
+
+bool ContactResponse::closes_left_out(const State& pose, const std::vector<Contact>& found, double h,
+                                      const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) const {
+  if (found.size() != left_out_.size()) return false;
+  for (std::size_t k = 0; k < found.size(); ++k)
+    if (left_out_[k] && gap_after_two_steps_of(found[k], pose, h, velocity, angular) <= tuning.penetration_slop)
+      return true;
+  return false;
+}
+
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
                                            const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
@@ -86,11 +104,14 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   std::vector<Contact>& contacts = kept_;
   contacts.clear();
   closing_.clear();
-  for (const Contact& c : found) {
-    const double un = c.normal.dot(relative_velocity(c, c.point - pose.position[c.a], c.point - pose.position[c.b],
-                                                     velocity, angular));
-    const double gap_after_two_steps = c.distance + 2.0 * h * std::min(un, 0.0);
-    if (c.distance > tuning.penetration_slop && gap_after_two_steps > tuning.penetration_slop) continue;
+  left_out_.assign(found.size(), 0);
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    const Contact& c = found[k];
+    const double gap_after_two_steps = gap_after_two_steps_of(c, pose, h, velocity, angular);
+    if (c.distance > tuning.penetration_slop && gap_after_two_steps > tuning.penetration_slop) {
+      left_out_[k] = 1;
+      continue;
+    }
     closing_.push_back({gap_after_two_steps, static_cast<int>(closing_.size())});
     contacts.push_back(c);
   }

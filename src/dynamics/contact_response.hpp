@@ -86,6 +86,14 @@ class ContactResponse {
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
                             bool& has_pseudo);
 
+  // Whether, at the velocities `velocity`/`angular` (world), some contact of `found` (the list the last
+  // resolve() was given, at the same `pose` and `h`) that resolve() left out as neither touching nor
+  // closing now closes within two steps: the impulses of the others knocked one of its components
+  // towards the other. Such a contact must be solved with the rest (Simulation::kick_and_collide resolves
+  // again): left out, nothing would stop it within the step.
+  bool closes_left_out(const State& pose, const std::vector<Contact>& found, double h, const std::vector<Vec3>& velocity,
+                       const std::vector<Vec3>& angular) const;
+
   // After the joints' impulses changed the velocities (SHAKE), make the contacts kept by the last
   // resolve() hold again: the same collision matrix, targets without restitution (the bounce was
   // given), the extra impulses applied to `velocity`/`angular`. Returns whether any impulse was needed
@@ -123,6 +131,9 @@ class ContactResponse {
   const Mat3& basis(int k) const { return basis_[k]; }
 
  private:
+  // Contact c's gap after two steps of h at its normal approach speed (resolve's test of what to keep).
+  static double gap_after_two_steps_of(const Contact& c, const State& pose, double h,
+                                       const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular);
   // Tree-solve the response to contact impulses `P` (contact bases, 3 per contact) into du_.
   void respond(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
   // The impulses `P` as wrenches on the contacts' bodies (wrench_, listed in touched_), and back to zero.
@@ -133,6 +144,7 @@ class ContactResponse {
   TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose
   std::vector<Contact> kept_;     // the contacts solved: touching, overlapping or closing
   std::vector<std::pair<double, int>> closing_;  // their gap after two steps (m) and index
+  std::vector<char> left_out_;  // per contact of the last resolve's `found`: neither touching nor closing
   std::vector<Mat3> basis_;
   std::vector<Vec3> arm_a_, arm_b_;  // centre of mass of a (b) -> contact point, world, m
   std::vector<ContactLawRow> rows_;
