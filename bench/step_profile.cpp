@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
           if (now.angular[i].squaredNorm() > now.angular[fastest].squaredNorm()) fastest = i;
         const double kinetic = kinetic_energy(model, now);
         std::printf("steps %ld-%ld: %.1f us/step, %.3f halvings per step; then energy %.6f J (kinetic %.6f), "
-                    "fastest spin %.1f rad/s ('%s', %.3g kg), deepest overlap so far %.3g mm (%.2f of its pair's thinnest half-width)\n",
+                    "fastest spin %.1f rad/s ('%s', %.3g kg), deepest overlap so far %.3g mm (%.2f of its pair's "
+                    "thinnest half-width)\n",
                     done, done + block, 1e6 * block_seconds / block,
                     static_cast<double>(sim.subdivisions() - block_halvings) / block,
                     kinetic + potential_energy(model, now), kinetic, now.angular[fastest].norm(),

@@ -91,8 +91,8 @@ class ContactResponse {
   // closing now closes within two steps: the impulses of the others knocked one of its components
   // towards the other. Such a contact must be solved with the rest (Simulation::kick_and_collide resolves
   // again): left out, nothing would stop it within the step.
-  bool closes_left_out(const State& pose, const std::vector<Contact>& found, double h, const std::vector<Vec3>& velocity,
-                       const std::vector<Vec3>& angular) const;
+  bool closes_left_out(const State& pose, const std::vector<Contact>& found, double h,
+                       const std::vector<Vec3>& velocity, const std::vector<Vec3>& angular) const;
 
   // After the joints' impulses changed the velocities (SHAKE), make the contacts kept by the last
   // resolve() hold again: the same collision matrix, targets without restitution (the bounce was
