@@ -242,6 +242,11 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   std::normal_distribution<double> g;
   const double weight = 9.81 * model.balance.total_mass;
   double worst_gain = 0, worst_left_overlap = 0, worst_relative_overlap = 0;
+  // The work the shaking does (J: each step's force on each component times its centre's displacement),
+  // for the energy the contacts may have taken out.
+  double shaking_work = 0;
+  std::vector<Vec3> shaken_from(model.count);
+  const double energy_at_start = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
   // 10 minutes of simulated time in cycles of 2 s: shaken hard for 1 s, as if the hook were jerked about
   // (a uniform random acceleration of 0.5 g rms per axis, a new one every 50 ms: the arms swing
   // through half a turn and knock into each other), then left alone for 1 s. One minute under the
@@ -256,7 +261,9 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   for (int cycle = 0; cycle < cycles; ++cycle) {
     for (int step = 0; step < 1000; ++step) {  // shaken for 1 s
       test::shake(model, sim, rng, g, step);
+      for (int i = 1; i < model.count; ++i) shaken_from[i] = sim.state().position[i];
       ASSERT_TRUE(sim.step()) << sim.failure()->message;
+      for (int i = 1; i < model.count; ++i) shaking_work += sim.loads().force[i].dot(sim.state().position[i] - shaken_from[i]);
       for (const Contact& c : sim.contacts()) worst_relative_overlap = std::max(worst_relative_overlap, -c.distance / c.thinnest);
     }
     sim.loads().clear();
@@ -329,11 +336,20 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   EXPECT_LT(stats.deepest_relative, 1.0);
   // Left alone, the energy never grows by more than allowed above.
   EXPECT_LT(worst_gain, 1.0);
+  // What the contacts took out is what the shaking put in less what the mobile kept: no damping here, so
+  // nothing else takes energy out. Allowed: 5 % of the work (measured 1.4 % more taken out than that,
+  // 719 J against 709: the overlap push's lift, the integrator's error and the solves' measure on the
+  // half-kicked velocities; not traced further). Before 2026-12-06 the contact law could return impulses
+  // of 1e10 N s along its collision matrix's null space, and their round-off alone counted 6.8e5 J taken
+  // out in one step, 1000 times all the shaking did (ContactLaw.APolishThatThrowsTheImpulsesOutOfScaleIsRefused).
+  const double kept = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()) - energy_at_start;
+  EXPECT_NEAR(stats.energy_removed, shaking_work - kept, 0.05 * shaking_work);
   std::printf("steel fish shaken %d s: %lld contact impulses (%lld sliding), deepest transient overlap %.3g mm, "
               "deepest after a second left alone %.3g mm, energy removed %.3g J, worst gain when left alone "
               "%.3g of the allowance\n",
               2 * cycles, stats.impulses, stats.sliding, stats.deepest * 1e3, worst_left_overlap * 1e3,
               stats.energy_removed, worst_gain);
+  std::printf("  the shaking's work %.4g J, kept by the mobile %.4g J\n", shaking_work, kept);
   std::printf("  deepest overlap at a step's start %.3f of the thinnest half-width near it (%.3f at a substep's)\n",
               worst_relative_overlap, stats.deepest_relative);
 }

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "aloft/math.hpp"
 #include "dynamics/contact_law.hpp"
@@ -336,6 +337,61 @@ TEST(ContactLaw, DependentContactsMeetTheLaw) {
     std::printf("mu %.1f: %d of 50 landings solved without friction, %d without it at some corners\n", mu,
                 dropped, in_part);
   }
+}
+
+TEST(ContactLaw, APolishThatThrowsTheImpulsesOutOfScaleIsRefused) {
+  // Three contacts between two arms of the Steel Fish shaken hard (written out from the shaking of
+  // Collisions.SteelFishShakenHard..., t = 68.2 s; mu = 0.4): 9 rows on the pair's 6 relative freedoms, so
+  // K has three zero eigenvalues (1e-15 of its largest). The Newton polish of the sweeps stepped along a
+  // nearly singular direction of its Jacobian, and the sweeps after it called 6.8e10 N s converged: the
+  // velocities barely moved (that direction is near K's null space), the middle contact still approached
+  // at 0.040 m/s against a target of 0.0078, and the energy change read -6.8e5 J, from round-off alone.
+  // Such polishes are now refused (contact_law.cpp, kPolishGrowth).
+  Eigen::MatrixXd K(9, 9);
+  K << 26.194318379540654, -3.3164977138047753, 7.9533395255618666, -13.335785346456149, -6.6326681242812446,
+      -4.3862259038238207, -23.112697631667409, 10.677237419236286, -10.317873755957303,  //
+      -3.3164977138047775, 24.70518306947088, 3.0893274343563126, -0.039836252391454219, 23.221817516995127,
+      -1.3300546880051238, 16.109039868326164, 19.030184858975986, -2.6937719965765647,  //
+      7.9533395255618675, 3.0893274343563109, 38.755584394527581, -3.0781715623171038, -5.1628249493672005,
+      -28.587506423629367, -1.7355459561651492, 4.6147533700432817, -38.975082416407488,  //
+      -13.335785346456149, -0.039836252391454219, -3.0781715623171038, 13.01092178979469, 0.5453002549701903,
+      2.3613199527018862, 10.956125355078543, -6.9748191644147441, 4.4723595904317275,  //
+      -6.6326681242812446, 23.221817516995127, -5.1628249493672005, 0.54530025497018964, 26.580346083242603,
+      0.51585214729155882, 17.419067333705073, 16.504310158646206, 5.7878852763946282,  //
+      -4.3862259038238207, -1.3300546880051238, -28.587506423629367, 2.3613199527018862, 0.51585214729156315,
+      26.980277213006602, 0.51831218390083988, -1.8400860821887686, 28.553151275127192,  //
+      -23.112697631667409, 16.109039868326164, -1.7355459561651492, 10.956125355078543, 17.419067333705073,
+      0.51831218390083988, 27.812149119608353, 1.4661175639013586, 3.9158288803351309,  //
+      10.677237419236286, 19.030184858975986, 4.6147533700432817, -6.9748191644147441, 16.504310158646206,
+      -1.8400860821887686, 1.4661175639013591, 21.581033426285792, -5.5294317738872261,  //
+      -10.317873755957303, -2.6937719965765647, -38.975082416407488, 4.4723595904317275, 5.7878852763946282,
+      28.553151275127192, 3.9158288803351322, -5.5294317738872252, 39.426214001602382;
+  Eigen::VectorXd u(9);
+  u << -0.0044969534066552456, -0.047357317139828728, -0.0026286758726822559, -0.0079557156600157108,
+      0.25311135175159727, -0.422808550229963, -0.019626286755871195, -0.037954020384382225, 0.0060216467893982996;
+  const std::vector<ContactLawRow> rows = {
+      {-0.0, 0.4}, {-0.007821177143126426, 0.4}, {0.005887886026761358, 0.4}};
+  Eigen::VectorXd P;
+  const ContactLawResult r = solve_contact_law(K, u, rows, P);
+  ASSERT_TRUE(P.allFinite());
+  // The impulses in scale: a few mN s (it ends without friction, 4.2e-3 N s at most), where the refused
+  // polish left 6.8e10. 1 N s would stop 1 kg moving at 1 m/s, far beyond anything these two arms (K's
+  // diagonal, 13-39 per kg) bring to the contacts at 0.05-0.5 m/s.
+  EXPECT_LT(P.cwiseAbs().maxCoeff(), 1.0);
+  // The law met: every contact at least at its target, pushing only where it is at it, inside the cone.
+  const Eigen::VectorXd after = u + K * P;
+  const double scale = u.cwiseAbs().maxCoeff();  // 0.42 m/s
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GE(after[3 * k], rows[k].target_normal - 1e-9 * scale) << "contact " << k;
+    EXPECT_GE(P[3 * k], 0.0);
+    EXPECT_LE(std::abs(P[3 * k] * (after[3 * k] - rows[k].target_normal)), 1e-9 * scale * P.cwiseAbs().maxCoeff());
+    EXPECT_LE(P.segment<2>(3 * k + 1).norm(), rows[k].friction * P[3 * k] * (1 + 1e-12) + 1e-15);
+  }
+  // Energy only leaves, and no more of it than the relative motion at the contacts carries: u^T K^+ u / 2
+  // = 0.0168 J (K's pseudo-inverse, rank 6), what stopping it all would take out. (Measured -4.5e-5 J; the
+  // refused polish's -6.8e5 J was the round-off of its out-of-scale impulses.)
+  EXPECT_LE(r.energy_change, 0.0);
+  EXPECT_GT(r.energy_change, -0.0168);
 }
 
 TEST(ContactLaw, ContactsThatSettleKeepTheirFrictionWhenOthersDoNot) {
