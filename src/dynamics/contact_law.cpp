@@ -316,14 +316,15 @@ constexpr double kPolishStepTolerance = 1e-10;  // of the largest impulse: a cho
 constexpr double kPolishRank = 1e-12;  // pivots below this fraction of the largest are taken as zero
 // A polish refines the impulses the sweeps are converging to. One that leaves some impulse more than
 // kPolishGrowth times the largest of the sweep before it has stepped along a nearly singular direction
-// of its Jacobian (the rows of contacts between the same two bodies are dependent, and the sliding rows
-// can make the Jacobian nearly singular where K is not quite) and is refused; the sweeps go on from
-// where they were. Such a step need not change the velocities much (it lies near K's null space), so the
-// sweep after it could call it converged: on the Steel Fish shaken hard (t = 68.2 s of the test's
-// shaking), three contacts between an arm and a leaf ended at 6.8e10 N s, with one of them still
-// approaching at 0.04 m/s against a target of 0.008 m/s, and an energy change of -6.8e5 J from round-off
-// alone (ContactLaw.APolishThatThrowsTheImpulsesOutOfScaleIsRefused; before, a later such solve gave
-// 6.8e21 N s and velocities of 1e7 m/s, a step that only the step-size rule's halving kept out).
+// of its Jacobian (three or more contacts between the same two bodies have more rows than the pair has
+// relative freedoms, and the sliding rows can make the Jacobian nearly singular where K is not quite)
+// and is refused; the sweeps go on from where they were. Such a step need not change the velocities
+// much (it lies near K's null space), so the sweep after it could call it converged: on the Steel Fish
+// shaken hard (t = 68.2 s of the test's shaking), three contacts between two arms ended at 6.8e10 N s,
+// with one of them still approaching at 0.04 m/s against a target of 0.008 m/s, and an energy change of
+// -6.8e5 J from round-off alone (ContactLaw.APolishThatThrowsTheImpulsesOutOfScaleIsRefused; before, a
+// later such solve gave 6.8e21 N s and velocities of 1e7 m/s, in a substep the step's checks then
+// rejected).
 // Measured on 10,699 solves written out from `aloft_step_profile 1023 5000 1 swinging:7` and solved again
 // (docs/performance.md, "2026-12-06, second session"): of about 19,400 polishes, 675 made some impulse
 // more than 100 times the sweep's largest (at most 5.4e18 times); refusing them, the solves took 149,003

@@ -340,7 +340,7 @@ TEST(ContactLaw, DependentContactsMeetTheLaw) {
 }
 
 TEST(ContactLaw, APolishThatThrowsTheImpulsesOutOfScaleIsRefused) {
-  // Three contacts between two arms of the Steel Fish shaken hard (written out from the shaking of
+  // Three contacts between the arms O2 and O7 of the Steel Fish shaken hard (written out from the shaking of
   // Collisions.SteelFishShakenHard..., t = 68.2 s; mu = 0.4): 9 rows on the pair's 6 relative freedoms, so
   // K has three zero eigenvalues (1e-15 of its largest). The Newton polish of the sweeps stepped along a
   // nearly singular direction of its Jacobian, and the sweeps after it called 6.8e10 N s converged: the
