@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dynamics/contact_sweep.hpp"
 #include "dynamics/contact_travel.hpp"
@@ -175,24 +176,27 @@ bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
     return s;
   };
   // How far any point of one side's pieces in contact travels (m), from the speed of their fastest point:
-  // at most |v| + |w| times the pieces' reach from the centre of mass, and at most the fastest corner of
-  // the box around them, |v + w x corner| (sharper for a piece turning about an axis through or near it,
-  // as a plate spinning on its thread; to first order in the turn). Any other piece of the pair that could
-  // come near within the step is within the detection margin, which the component's whole reach sets, so
-  // it is a contact of its own, checked here too.
-  const auto travel = [&](const Contact& c, int k) {
+  // at most |v| + |w| times the pieces' reach from the centre of mass (travel_by_reach), and at most the
+  // fastest corner of the box around them, |v + w x corner| (travel_by_box; sharper for a piece turning
+  // about an axis through or near it, as a plate spinning on its thread; to first order in the turn;
+  // infinite where no box is known). Any other piece of the pair that could come near within the step is
+  // within the detection margin, which the component's whole reach sets, so it is a contact of its own,
+  // checked here too.
+  const auto travel_by_reach = [&](const Contact& c, int k) {
     const int i = k == 0 ? c.a : c.b;
     if (i == 0) return 0.0;
     const Motion m = motion(i);
     const double reach = std::min(work.detector->reach(i), k == 0 ? c.reach_a : c.reach_b);
-    const double turn = m.drift.norm() + m.push.norm();
-    double far = h * (m.velocity.norm() + turn * reach);
+    return h * (m.velocity.norm() + (m.drift.norm() + m.push.norm()) * reach);
+  };
+  const auto travel_by_box = [&](const Contact& c, int k) {
+    const int i = k == 0 ? c.a : c.b;
     const Vec3& low = k == 0 ? c.near_low_a : c.near_low_b;
     const Vec3& high = k == 0 ? c.near_high_a : c.near_high_b;
-    if (low.x() <= high.x())
-      far = std::min(far, h * (fastest_corner_speed(state_.orientation[i], m.velocity, m.drift, low, high) +
-                               m.push.norm() * farthest_corner(low, high)));
-    return far;
+    if (i == 0 || !(low.x() <= high.x())) return std::numeric_limits<double>::infinity();
+    const Motion m = motion(i);
+    return h * (fastest_corner_speed(state_.orientation[i], m.velocity, m.drift, low, high) +
+                m.push.norm() * farthest_corner(low, high));
   };
   // What a contact may get deeper in one step (m): kDeepeningPerHalfWidth of its pieces' thinnest
   // half-width, and at most kMaxContactTravel.
@@ -200,12 +204,18 @@ bool Simulation::contacts_move_slowly_enough(double h, bool pushed) const {
     return std::min(kMaxContactTravel, kDeepeningPerHalfWidth * c.thinnest);
   };
   // The pieces can come closer by at most the sum of how far the two sides travel: when that is within
-  // what the contact may deepen, so is the deepening. (Until 2026-12-06 each side alone was held to
-  // kMaxContactTravel, which let the two come 2 kMaxContactTravel closer: 1 mm, against the generated
-  // mobiles' 0.5 mm threads. On generated-1023 after the breeze, a thread and its neighbour, 0.08 mm apart,
-  // met at 0.7 m/s within one step that both sides' travels allowed, and the next step began 0.62 mm deep:
-  // 1.25 times the thread's radius. docs/collisions.md, "How far pieces in contact may move per step".)
-  const auto travels_little = [&](const Contact& c) { return travel(c, 0) + travel(c, 1) <= allowed_deepening(c); };
+  // what the contact may deepen, so is the deepening. The cheap bound first, the boxes' corners only
+  // where it is not enough. (Until 2026-12-06 each side alone was held to kMaxContactTravel, which let the
+  // two come 2 kMaxContactTravel closer: 1 mm, against the generated mobiles' 0.5 mm threads. On
+  // generated-1023 after the breeze, a thread and its neighbour, 0.08 mm apart, met at 0.7 m/s within one
+  // step that both sides' travels allowed, and the next step began 0.62 mm deep: 1.25 times the thread's
+  // radius. docs/collisions.md, "How far pieces in contact may move per step".)
+  const auto travels_little = [&](const Contact& c) {
+    const double allowed = allowed_deepening(c);
+    const double by_reach[2] = {travel_by_reach(c, 0), travel_by_reach(c, 1)};
+    if (by_reach[0] + by_reach[1] <= allowed) return true;
+    return std::min(by_reach[0], travel_by_box(c, 0)) + std::min(by_reach[1], travel_by_box(c, 1)) <= allowed;
+  };
   // The bound on how much deeper the pieces get, where it covers them all: every nearby piece pair of
   // the two components is a contact (c.complete), each within a known box.
   const auto deepens_little = [&](const Contact& c) {
