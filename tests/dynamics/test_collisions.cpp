@@ -102,22 +102,18 @@ TEST(Collisions, WithCollisionsOffTheBallPassesThrough) {
   EXPECT_GT(furthest, 0.042);  // wholly through
 }
 
-// Three 20 mm balls in a row on 0.5 m threads (a Newton's cradle with gaps): the first 10.3 mm from the
-// second, swung at it; the second 0.3 mm from the third, far enough apart at rest not to be pruned as
-// touching (0.1 mm) and near enough to be in the detector's list at every step (its margin is 0.5 mm).
-const char* const kCradle = R"({
-  "name": "cradle", "contact": {"restitution": 0.5, "friction": 0.3},
-  "components": [
-    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.02, 1, 0], "to": [0.11, 1, 0], "radius": 0.003}}]},
-    {"name": "first", "parent": "hook", "joint": [-0.01, 1, 0], "shapes": [
-      {"wire": {"from": [-0.01, 1, 0], "to": [-0.01, 0.52, 0], "radius": 0.0005}},
-      {"sphere": {"center": [-0.01, 0.5, 0], "radius": 0.02}}]},
-    {"name": "second", "parent": "hook", "joint": [0.0403, 1, 0], "shapes": [
-      {"wire": {"from": [0.0403, 1, 0], "to": [0.0403, 0.52, 0], "radius": 0.0005}},
-      {"sphere": {"center": [0.0403, 0.5, 0], "radius": 0.02}}]},
-    {"name": "third", "parent": "hook", "joint": [0.0806, 1, 0], "shapes": [
-      {"wire": {"from": [0.0806, 1, 0], "to": [0.0806, 0.52, 0], "radius": 0.0005}},
-      {"sphere": {"center": [0.0806, 0.5, 0], "radius": 0.02}}]}]})";
+// A row of 20 mm balls on 0.5 m threads from the hook at the given x (m), in a row along x.
+std::string ball_row(const std::vector<double>& x) {
+  std::string json = R"({"name": "row", "contact": {"restitution": 0.5, "friction": 0.3}, "components": [
+    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.03, 1, 0], "to": [0.3, 1, 0], "radius": 0.003}}]})";
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const std::string at = std::to_string(x[i]);
+    json += R"(, {"name": "ball )" + std::to_string(i + 1) + R"(", "parent": "hook", "joint": [)" + at + R"(, 1, 0],
+      "shapes": [{"wire": {"from": [)" + at + R"(, 1, 0], "to": [)" + at + R"(, 0.52, 0], "radius": 0.0005}},
+                 {"sphere": {"center": [)" + at + R"(, 0.5, 0], "radius": 0.02}}]})";
+  }
+  return json + "]}";
+}
 
 // The first ball knocks the second at 2 m/s, which in the same 1 ms step would carry it 1.5 mm into the
 // third, 0.3 mm away and at rest. At the step's start that pair is apart and not closing, so the first
@@ -127,7 +123,10 @@ const char* const kCradle = R"({
 // halved the step 5 times, and a substep still began with the balls 0.44 mm deep. (On generated-1023
 // after the breeze a thread went 0.62 mm into its neighbour that way, past the thread's 0.5 mm radius.)
 TEST(Collisions, AKnockIsPassedOnWithinTheStep) {
-  const Model model = model_from(kCradle);
+  // A Newton's cradle with gaps: the first ball 10.3 mm from the second, swung at it; the second 0.3 mm
+  // from the third, far enough apart at rest not to be pruned as touching (0.1 mm) and near enough to be
+  // in the detector's list at every step (its margin is 0.5 mm).
+  const Model model = model_from(ball_row({-0.01, 0.0403, 0.0806}));
   Simulation sim(model);
   {
     State& s = sim.mutable_state();
@@ -146,19 +145,6 @@ TEST(Collisions, AKnockIsPassedOnWithinTheStep) {
   EXPECT_LT(sim.collision_statistics().deepest, 5e-5);
   // ... and no step divided for it: solved in the step, the balls move no faster than the step allows.
   EXPECT_EQ(sim.subdivisions(), 0);
-}
-
-// A row of 20 mm balls on 0.5 m threads from the hook at the given x (m), in a row along x.
-std::string ball_row(const std::vector<double>& x) {
-  std::string json = R"({"name": "row", "contact": {"restitution": 0.5, "friction": 0.3}, "components": [
-    {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.03, 1, 0], "to": [0.3, 1, 0], "radius": 0.003}}]})";
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const std::string at = std::to_string(x[i]);
-    json += R"(, {"name": "ball )" + std::to_string(i + 1) + R"(", "parent": "hook", "joint": [)" + at + R"(, 1, 0],
-      "shapes": [{"wire": {"from": [)" + at + R"(, 1, 0], "to": [)" + at + R"(, 0.52, 0], "radius": 0.0005}},
-                 {"sphere": {"center": [)" + at + R"(, 0.5, 0], "radius": 0.02}}]})";
-  }
-  return json + "]}";
 }
 
 // Six balls in a row, the two at the ends swung at the others at the same speed: 10.3 mm from the end
