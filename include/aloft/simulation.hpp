@@ -62,7 +62,11 @@ struct CollisionStatistics {
   // next step looks at them again).
   long long law_solves = 0, law_contacts = 0, law_sweeps = 0;
   long long contacts_left = 0;
-  double energy_removed = 0;          // J of kinetic energy the impulses took out (>= 0)
+  // J: the energy the contact impulses took out of the mobile, summed over the steps, each step's
+  // weighed at its start velocities (ContactStepReport::energy_change; a step that only holds pieces at
+  // rest adds about 0, of either sign). Without air damping, the energy the mobile lost is this, less
+  // what the overlap pushes lift and the integrator's own error (docs/collisions.md, "Energy").
+  double energy_removed = 0;
   double deepest = 0;                 // m, largest overlap seen at the start of a step
   // The largest overlap seen at the start of a step as a fraction of the smallest half-width of its
   // pair's pieces near the contact (Contact::thinnest: a wire's radius, half a plate's thickness). At 1

@@ -38,7 +38,8 @@ ContactResponse::ContactResponse(const Model& model)
     : model_(model),
       path_position_(model.count, -1),
       wrench_(model.count, Vec6::Zero()),
-      du_(model.count, Vec6::Zero()) {}
+      du_(model.count, Vec6::Zero()),
+      first_change_(model.count, Vec6::Zero()) {}
 
 void ContactResponse::gather_wrenches(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
   const int m = static_cast<int>(contacts.size());
@@ -91,9 +92,11 @@ bool ContactResponse::closes_left_out(const State& pose, const std::vector<Conta
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
                                            const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
-                                           std::vector<Vec6>& pseudo, bool& has_pseudo) {
+                                           std::vector<Vec6>& pseudo, bool& has_pseudo, bool again) {
   ContactStepReport report;
   has_pseudo = false;
+  const bool after_first = again && has_first_change_;
+  has_first_change_ = false;
   report.contacts = static_cast<int>(found.size());
   solver_ = &solver;
 
@@ -281,8 +284,28 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   report.iterations = sweeps;
   report.sticking = law.sticking;
   report.sliding = law.sliding;
-  report.energy_change = law.energy_change;
   for (int k = 0; k < m; ++k) report.active += P_[3 * k] > 0;
+  // The law's energy change, u^T P + P^T K P / 2, is weighed at the half-kicked velocities u; the step's
+  // is weighed at its start velocities u_start = u - (what the half kick did at the contact):
+  // u_start^T P + P^T K P / 2 (see resolve's declaration).
+  report.energy_change = law.energy_change;
+  if (report.active > 0) {
+    const auto start_velocity = [&](int body, const Vec3& arm) {
+      if (body == 0) return Vec3(Vec3::Zero());
+      Vec3 v = pose.velocity[body], w = pose.angular[body];
+      if (after_first) {
+        v += first_change_[body].head<3>();
+        w += first_change_[body].tail<3>();
+      }
+      return Vec3(v + w.cross(arm));
+    };
+    for (int k = 0; k < m; ++k) {
+      const Contact& c = contacts[k];
+      const Vec3 u_start =
+          basis_[k].transpose() * (start_velocity(c.a, arm_a_[k]) - start_velocity(c.b, arm_b_[k]));
+      report.energy_change -= P_.segment<3>(3 * k).dot(u_.segment<3>(3 * k) - u_start);
+    }
+  }
 
   // Apply: one tree solve with G^T P gives every body's velocity change and the joint impulses.
   if (report.active > 0) {
@@ -291,6 +314,9 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       velocity[i] += du_[i].head<3>();
       angular[i] += du_[i].tail<3>();
     }
+    // Kept for a second resolve's energy change (du_ is overwritten below and by the contact passes).
+    std::swap(first_change_, du_);
+    has_first_change_ = !again;
   }
 
   // Split impulse: a frictionless pseudo-velocity that removes a part of each overlap beyond the slop.

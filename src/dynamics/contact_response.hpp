@@ -68,7 +68,10 @@ struct ContactStepReport {
   bool friction_dropped = false;     // the law with friction did not converge, or added energy (nearly
                                      // dependent contacts): solved frictionless, or with no impulse if
                                      // that gained too
-  double energy_change = 0;    // J, kinetic energy the impulses changed (<= 0 up to round-off)
+  // J: what the impulses change the mobile's energy by over the step, weighed at the step's start
+  // velocities (plus this step's earlier contact impulses), not at the half-kicked ones they act on
+  // (resolve() says why). Usually < 0; a step that only holds pieces at rest gives about 0, of either sign.
+  double energy_change = 0;
   double deepest = 0;          // m, largest overlap among the contacts (>= 0)
   double deepest_relative = 0; // the largest overlap over its contact's Contact::thinnest (>= 0)
 };
@@ -82,9 +85,17 @@ class ContactResponse {
   // not added to the step's joint impulses used for the next step's warm start (contacts are re-solved
   // every step), so they are not kept. `pseudo` (per body: linear m/s, angular rad/s) is
   // set to the penetration-removing pseudo-velocity; `has_pseudo` says whether it is non-zero.
+  // `pose` also holds the velocities the step started from, before its first half kick; `again` says
+  // that this is the step's second resolve, after the first one's impulses were added to `velocity`.
+  // Both are for the report's energy_change: the energy the impulses change is weighed at the step's
+  // start velocities (plus the first resolve's change when `again`), not at `velocity`. The split kick
+  // makes the difference: a piece resting on another falls by (h/2) g in the first half kick, the
+  // impulse stops that and the second half kick starts the fall again, so the piece keeps its energy
+  // from step to step, yet at the half-kicked velocity the impulse takes m (g h)^2 / 2 out of it. For
+  // constant forces the energy over the step changes by exactly dv^T M v_start + dv^T M dv / 2.
   ContactStepReport resolve(const State& pose, TreeSolver& solver, const std::vector<Contact>& contacts, double h,
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
-                            bool& has_pseudo);
+                            bool& has_pseudo, bool again = false);
 
   // Whether, at the velocities `velocity`/`angular` (world), some contact of `found` (the list the last
   // resolve() was given, at the same `pose` and `h`) that resolve() left out as neither touching nor
@@ -168,6 +179,10 @@ class ContactResponse {
   std::vector<Vec6> wrench_;   // per body, zero between uses
   std::vector<int> touched_;   // the bodies wrench_ is non-zero at (each contact's two)
   std::vector<Vec6> du_;
+  // The velocity change (per body: linear m/s, angular rad/s) of this step's first resolve, which weighs
+  // the second's energy change (resolve(), `again`); valid when has_first_change_.
+  std::vector<Vec6> first_change_;
+  bool has_first_change_ = false;
 };
 
 }  // namespace aloft

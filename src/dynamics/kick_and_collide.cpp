@@ -165,7 +165,8 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
       if (other) {
         std::swap(work.contacts, work.recheck);
         const ContactStepReport again =
-            work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
+            work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo,
+                                  /*again=*/true);
         contact_report.contacts = again.contacts;
         contact_report.dropped = again.dropped;  // what the step leaves unsolved is the last list's
         contact_report.solves += again.solves;

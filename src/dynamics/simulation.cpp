@@ -302,7 +302,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.law_contacts += contact_report.solved;
     stats.law_sweeps += contact_report.iterations;
     stats.contacts_left += contact_report.dropped;
-    stats.energy_removed -= std::min(0.0, contact_report.energy_change);
+    stats.energy_removed -= contact_report.energy_change;
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
     stats.deepest_relative = std::max(stats.deepest_relative, contact_report.deepest_relative);
   }

@@ -1,6 +1,7 @@
 // Collisions inside the simulation: no tunnelling through a thin plate, a knock passed on within its step,
 // pieces meeting from both sides held to what a step allows, resting contact without jitter or sinking,
-// energy that never grows, the Steel Fish shaken hard, and a crowded generated mobile in a breeze.
+// energy that never grows and that the contacts account for, the Steel Fish shaken hard, and a crowded
+// generated mobile in a breeze.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -199,6 +200,7 @@ TEST(Collisions, RestingContactNeitherJittersNorSinks) {
   ASSERT_TRUE(sim.advance(6.0));  // the knock and the bounces die out (damping 0.5/s, e = 0.3)
   double deepest = 0, moved = 0, lowest_gap = 1, highest_gap = -1;
   const Vec3 left = centre(sim.state(), 1), right = centre(sim.state(), 2);
+  const double removed_before = sim.collision_statistics().energy_removed;
   for (int step = 0; step < 1000; ++step) {
     ASSERT_TRUE(sim.step());
     const State& s = sim.state();
@@ -208,8 +210,9 @@ TEST(Collisions, RestingContactNeitherJittersNorSinks) {
     deepest = std::max(deepest, -gap);
     moved = std::max({moved, (centre(s, 1) - left).norm(), (centre(s, 2) - right).norm()});
   }
-  std::printf("leaning balls: gap from %.3g to %.3g mm, moved at most %.3g mm in 1 s\n", lowest_gap * 1e3,
-              highest_gap * 1e3, moved * 1e3);
+  const double removed = sim.collision_statistics().energy_removed - removed_before;
+  std::printf("leaning balls: gap from %.3g to %.3g mm, moved at most %.3g mm in 1 s, energy taken out %.3g J\n",
+              lowest_gap * 1e3, highest_gap * 1e3, moved * 1e3, removed);
   // Leaning, not hovering apart: in contact within the 0.05 mm penetration slop ...
   EXPECT_LT(highest_gap, 5e-5);
   // ... not sinking: the overlap stays at the slop's scale (0.05 mm, plus one step of gravity) ...
@@ -219,6 +222,10 @@ TEST(Collisions, RestingContactNeitherJittersNorSinks) {
   // g sin(1.15 deg) h / 2 = 0.1 mm/s, that the next step's contact impulse removes before anything moves.)
   EXPECT_LT(moved, 1e-6);
   EXPECT_LT(highest_gap - lowest_gap, 1e-5);
+  // Holding them there takes no energy out of them (CollisionStatistics::energy_removed): measured 4.3e-9
+  // J over the second. Weighed at the half-kicked velocities, as until 2026-12-06, each step's impulse
+  // took out the half kick's approach, m (g sin(1.15 deg) h)^2 / 2 with the pair's reduced mass: 3.4e-5 J.
+  EXPECT_LT(std::abs(removed), 1e-6);
 }
 
 TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) {
@@ -323,13 +330,14 @@ TEST(Collisions, SteelFishShakenHardStaysWholeAndNeverGainsEnergyWhenLeftAlone) 
   // Left alone, the energy never grows by more than allowed above.
   EXPECT_LT(worst_gain, 1.0);
   // What the contacts took out is what the shaking put in less what the mobile kept: no damping here, so
-  // nothing else takes energy out. Allowed: 5 % of the work (measured 1.4 % more taken out than that,
-  // 719 J against 709: the overlap push's lift, the integrator's error and the solves' measure on the
-  // half-kicked velocities; not traced further). Before 2026-12-06 the contact law could return impulses
-  // of 1e10 N s along its collision matrix's null space, and their round-off alone counted 6.8e5 J taken
-  // out in one step, 1000 times all the shaking did (ContactLaw.APolishThatThrowsTheImpulsesOutOfScaleIsRefused).
+  // nothing else takes energy out. Allowed: 1 % of the work, for the overlap push's lift and the
+  // integrator's error (measured 0.1 %: 708.0 J against 708.7). Weighed at the half-kicked velocities
+  // instead of the steps' start velocities, as until 2026-12-06 (see Collisions.EnergyTakenOutIsTheEnergyLost),
+  // it read 1.4 % more, 719 J against 709. And before then the contact law could return impulses of 1e10 N s
+  // along its collision matrix's null space, and their round-off alone counted 6.8e5 J taken out in one
+  // step, 1000 times all the shaking did (ContactLaw.APolishThatThrowsTheImpulsesOutOfScaleIsRefused).
   const double kept = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()) - energy_at_start;
-  EXPECT_NEAR(stats.energy_removed, shaking_work - kept, 0.05 * shaking_work);
+  EXPECT_NEAR(stats.energy_removed, shaking_work - kept, 0.01 * shaking_work);
   std::printf("steel fish shaken %d s: %lld contact impulses (%lld sliding), deepest transient overlap %.3g mm, "
               "deepest after a second left alone %.3g mm, energy removed %.3g J, worst gain when left alone "
               "%.3g of the allowance\n",
@@ -360,6 +368,41 @@ std::string spinning_thread(bool bar) {
       {"wire": {"from": [X, 1, 0], "to": [X, 0.55, 0], "radius": 0.0005}}]}]})";
   for (std::size_t at = json.find('X'); at != std::string::npos; at = json.find('X')) json.replace(at, 1, x);
   return json;
+}
+
+// The energy counter against the energy itself: a generated mobile of 127 components (generator seed 2)
+// set knocking by the bench's breeze for 0.3 s, then left alone for 3 s without air damping, so that
+// only the contacts take energy out. What CollisionStatistics::energy_removed says they took is what the
+// mobile lost, to within what the integrator and the overlap pushes change on their own. Weighed at the
+// half-kicked velocities, as until 2026-12-06, the counter read 0.0678 J against 0.0549 J lost (23 %
+// more): every piece resting on another counted m (g h)^2 / 2 per step that it never lost (see
+// ContactResponse::resolve).
+TEST(Collisions, EnergyTakenOutIsTheEnergyLost) {
+  GenerateOptions options;
+  options.components = 127;
+  options.seed = 2;
+  options.total_mass = 1.0;
+  MobileSpec spec = parse_mobile_text(generate_mobile(options), "generated-127.json");
+  spec.damping = DampingSpec{};
+  const Model model = compile(spec);
+  Simulation sim(model);
+  ASSERT_TRUE(sim.collisions());
+  test::blow_bench_breeze(model, sim);
+  ASSERT_TRUE(sim.advance(0.3)) << sim.failure()->message;
+  sim.loads().clear();
+  const double start = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
+  const double removed_before = sim.collision_statistics().energy_removed;
+  const long long impulses_before = sim.collision_statistics().impulses;
+  ASSERT_TRUE(sim.advance(3.0)) << sim.failure()->message;
+  const double lost = start - (kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()));
+  const double removed = sim.collision_statistics().energy_removed - removed_before;
+  std::printf("generated-127 left alone 3 s: %lld contact impulses, energy lost %.5g J, taken out by the contacts %.5g J\n",
+              sim.collision_statistics().impulses - impulses_before, lost, removed);
+  EXPECT_GT(sim.collision_statistics().impulses - impulses_before, 1000) << "the pieces should keep knocking";
+  EXPECT_GT(lost, 0.02) << "the knocks should take a good part of the energy out";
+  // Allowed: 5 % of what was lost (2.7 mJ), 2.5 times the integrator's own drift on this mobile over the
+  // same span with collisions off (1.1 mJ). Measured 0.16 %: 0.05483 J taken out, 0.05492 J lost.
+  EXPECT_NEAR(removed, lost, 0.05 * lost);
 }
 
 TEST(Collisions, AThreadSpinningAboutItsOwnAxisBesideAnotherKeepsItsStep) {
