@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "aloft/collision.hpp"
@@ -159,6 +160,11 @@ class Simulation {
   void set_collisions(bool enabled);
   bool collisions() const { return collisions_; }
   const std::vector<Contact>& contacts() const;
+  // The pairs of components (a < b) that a contact impulse pushed apart in the last step (in any of its
+  // accepted substeps; a pair may appear more than once). A knock is often stopped and turned back
+  // before its pieces meet (the speculative contacts of docs/collisions.md), so it may show in no
+  // contact's distance at a step's start: this is where to see it.
+  const std::vector<std::pair<int, int>>& pushed_pairs() const;
   const CollisionStatistics& collision_statistics() const { return collision_stats_; }
   // The detector (for its pair pruning), or null when collisions are off.
   const CollisionDetector* collision_detector() const;

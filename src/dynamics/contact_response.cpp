@@ -97,6 +97,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   has_pseudo = false;
   const bool after_first = again && has_first_change_;
   has_first_change_ = false;
+  if (!again) pushed_pairs_.clear();
   report.contacts = static_cast<int>(found.size());
   solver_ = &solver;
 
@@ -284,7 +285,11 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   report.iterations = sweeps;
   report.sticking = law.sticking;
   report.sliding = law.sliding;
-  for (int k = 0; k < m; ++k) report.active += P_[3 * k] > 0;
+  for (int k = 0; k < m; ++k)
+    if (P_[3 * k] > 0) {
+      ++report.active;
+      pushed_pairs_.emplace_back(contacts[k].a, contacts[k].b);
+    }
   // The law's energy change, u^T P + P^T K P / 2, is weighed at the half-kicked velocities u; the step's
   // is weighed at its start velocities u_start = u - (what the half kick did at the contact):
   // u_start^T P + P^T K P / 2 (see resolve's declaration).

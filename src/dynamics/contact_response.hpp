@@ -130,6 +130,10 @@ class ContactResponse {
   static constexpr int kMaxContacts = 128;
   // The contacts the last resolve() solved, in the order of the matrices below.
   const std::vector<Contact>& kept() const { return kept_; }
+  // The pairs of components (a < b) given a normal impulse by the step's resolves (the first, and the
+  // second when `again`; a pair may appear more than once). The contact passes' corrections are not
+  // included.
+  const std::vector<std::pair<int, int>>& pushed_pairs() const { return pushed_pairs_; }
 
   ContactTuning tuning;
 
@@ -183,6 +187,7 @@ class ContactResponse {
   // the second's energy change (resolve(), `again`); valid when has_first_change_.
   std::vector<Vec6> first_change_;
   bool has_first_change_ = false;
+  std::vector<std::pair<int, int>> pushed_pairs_;
 };
 
 }  // namespace aloft

@@ -84,6 +84,8 @@ void Simulation::set_sparse_corrections(bool on) { work_->most_open = on ? work_
 
 const std::vector<Contact>& Simulation::contacts() const { return work_->contacts; }
 
+const std::vector<std::pair<int, int>>& Simulation::pushed_pairs() const { return work_->pushed_pairs; }
+
 const CollisionDetector* Simulation::collision_detector() const { return work_->detector.get(); }
 
 Simulation::~Simulation() = default;
@@ -305,6 +307,10 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.energy_removed -= contact_report.energy_change;
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
     stats.deepest_relative = std::max(stats.deepest_relative, contact_report.deepest_relative);
+    if (contact_report.active > 0) {
+      const std::vector<std::pair<int, int>>& pushed = work.response.pushed_pairs();
+      work.pushed_pairs.insert(work.pushed_pairs.end(), pushed.begin(), pushed.end());
+    }
   }
   return true;
 }
@@ -349,6 +355,7 @@ bool Simulation::step() {
   work_->rejection = StepWorkspace::Rejection::kNone;
   work_->rejected_value = 0;
   work_->deepest = 0;
+  work_->pushed_pairs.clear();
   const bool converged = advance_by(timestep_, 0);
   // The next step starts as deep as this one needed to go; after kStepsBeforeCoarser steps that needed
   // no deeper, one level less deep.

@@ -114,6 +114,7 @@ struct StepWorkspace {
   // Collisions.
   std::unique_ptr<CollisionDetector> detector;  // null while collisions are off
   std::vector<Contact> contacts;  // found at the start of the last (sub)step
+  std::vector<std::pair<int, int>> pushed_pairs;  // of the accepted (sub)steps of the step so far
   ContactResponse response;
   std::vector<Vec6> pseudo;       // per body: penetration-removing pseudo-velocity (drift only)
   State probe;                    // the current pose with the half-step velocities, for detection
