@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "aloft/model.hpp"
+#include "support/leaning_balls.hpp"
 
 namespace aloft {
 namespace {
@@ -192,6 +193,48 @@ TEST_F(Cli, SimulateQuotesNames) {
   const std::string csv = read(dir_ / "t.csv");
   EXPECT_NE(csv.find("\n0,\"leaf, \"\"red\"\"\",-0.5,"), std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 4 * 3);
+}
+
+// The collision lines of the summary, and --contacts-out: the two leaning balls (they knock at 0.34 s,
+// bounce, and rest on each other) are the one pair that touched.
+TEST_F(Cli, SimulateReportsThePairsThatTouched) {
+  write(dir_ / "balls.json", test::kLeaningBalls);
+  const Result r = aloft("simulate balls.json -t 3 --contacts-out pairs.csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("collisions        on: 1 of 3 pairs can touch"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("restitution 0.3, friction 0.5"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("touching pairs    1 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'left' and 'right': "), std::string::npos) << r.out;
+  std::istringstream csv(read(dir_ / "pairs.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line, "component_a,component_b,steps,first_t,last_t,deepest_overlap_m");
+  ASSERT_TRUE(std::getline(csv, line));
+  ASSERT_EQ(line.rfind("left,right,", 0), 0u) << line;
+  std::istringstream row(line.substr(std::string("left,right,").size()));
+  long long steps = 0;
+  char comma = 0;
+  double first = 0, last = 0, deepest = -1;
+  row >> steps >> comma >> first >> comma >> last >> comma >> deepest;
+  EXPECT_GT(steps, 1000);  // resting on each other from about 1.5 s on
+  EXPECT_LE(steps, 3000);
+  EXPECT_GT(first, 0.25);
+  EXPECT_LT(first, 0.45);
+  EXPECT_NEAR(last, 3.0, 1e-9);
+  EXPECT_GE(deepest, 0.0);
+  EXPECT_LT(deepest, 1e-4);
+  EXPECT_FALSE(std::getline(csv, line)) << "one pair only";
+
+  const Result off = aloft("simulate balls.json -t 1 --no-collisions --contacts-out none.csv");
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_NE(off.out.find("collisions        off (--no-collisions)"), std::string::npos) << off.out;
+  EXPECT_EQ(off.out.find("touching pairs"), std::string::npos) << off.out;
+  EXPECT_EQ(read(dir_ / "none.csv"), "component_a,component_b,steps,first_t,last_t,deepest_overlap_m\n");
+
+  // An unwritable CSV fails before the run, with the path in the message.
+  const Result bad = aloft("simulate balls.json -t 100 --contacts-out no-such-dir/pairs.csv");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("cannot write no-such-dir/pairs.csv"), std::string::npos) << bad.err;
 }
 
 TEST_F(Cli, BadFilesExitOneWithFileAndLine) {
