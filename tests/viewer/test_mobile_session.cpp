@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "mobile_session.hpp"
+#include "support/leaning_balls.hpp"
 
 namespace aloft::view {
 namespace {
@@ -161,6 +162,25 @@ TEST_F(Session, PacingFollowsTheWallClockAndTheTimeScale) {
   EXPECT_NEAR(session.simulation().state().time - t, h, 1e-12);
   session.reset();
   EXPECT_EQ(session.simulation().state().time, 0.0);
+}
+
+// The Contacts panel's tally: the leaning balls knock at 0.34 s and rest on each other; the pair is
+// touching at the last step; a reset starts the tally afresh.
+TEST_F(Session, CountsThePairsThatTouchAndStartsAfreshOnReset) {
+  const fs::path balls = dir_ / "balls.json";
+  std::ofstream(balls, std::ios::binary) << aloft::test::kLeaningBalls;
+  MobileSession session(balls.string());
+  for (int step = 0; step < 3000; ++step) session.single_step();
+  const std::vector<ContactTally::Pair> pairs = session.contact_tally().pairs();
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(session.model().names[pairs[0].a], "left");
+  EXPECT_EQ(session.model().names[pairs[0].b], "right");
+  EXPECT_GT(pairs[0].steps, 1000);
+  EXPECT_EQ(pairs[0].last, session.last_step_time()) << "touching now";
+  session.reset();
+  EXPECT_TRUE(session.contact_tally().pairs().empty());
+  session.single_step();  // at rest in the drawn pose, 10 degrees apart: nothing touches
+  EXPECT_TRUE(session.contact_tally().pairs().empty());
 }
 
 }  // namespace

@@ -111,6 +111,7 @@ void MobileSession::install(std::unique_ptr<MobileSpec> spec, std::unique_ptr<Mo
   sim_->loads().resize(model_->count);
   grab_.reset();
   debt_ = 0;
+  contacts_ = ContactTally{};
   ++generation_;
 }
 
@@ -170,6 +171,7 @@ void MobileSession::reset() {
   }
   grab_.reset();
   debt_ = 0;
+  contacts_ = ContactTally{};
 #if ALOFT_HAVE_WIND
   since_refresh_ = 1e9;
   for (FileWind& w : file_winds_) w.since_refresh = 1e9;
@@ -297,8 +299,9 @@ void MobileSession::step_once() {
     loads.torque[c] += (s.orientation[c] * grab_->point_body).cross(f);
   }
   const auto t0 = Clock::now();
-  sim_->step();
+  const bool stepped = sim_->step();
   physics_seconds_ += seconds(Clock::now() - t0);
+  if (stepped && sim_->collisions()) contacts_.add_step(sim_->contacts(), sim_->pushed_pairs(), sim_->state().time);
 }
 
 double MobileSession::advance(double wall_seconds, double budget_seconds) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "aloft/contact_tally.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
@@ -114,6 +115,13 @@ class MobileSession {
   const std::optional<Grab>& grabbed() const { return grab_; }
   Vec3 grab_force() const;      // N, world: the spring's pull now (0 without a grab)
 
+  // The pairs of components that touched since the mobile was loaded, rebuilt or reset (or
+  // clear_contacts()), counted at every step (include/aloft/contact_tally.hpp); the last step's end time,
+  // to tell the pairs touching now (Pair::last equal to it).
+  const ContactTally& contact_tally() const { return contacts_; }
+  double last_step_time() const { return sim_->state().time; }
+  void clear_contacts() { contacts_ = ContactTally{}; }
+
   // Compute time of the last advance(), s: physics (solver) and wind (occlusion and forces).
   double last_physics_seconds() const { return physics_seconds_; }
   double last_wind_seconds() const { return wind_seconds_; }
@@ -158,6 +166,7 @@ class MobileSession {
   double debt_ = 0;                    // simulated seconds owed to the wall clock
   std::optional<Grab> grab_;
   double physics_seconds_ = 0, wind_seconds_ = 0;
+  ContactTally contacts_;
 #if ALOFT_HAVE_WIND
   void build_file_winds(const std::vector<FileWind>& before);
   std::unique_ptr<Wind> wind_;

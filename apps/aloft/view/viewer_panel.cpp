@@ -317,6 +317,26 @@ void ViewerState::draw_panel() {
   }
 #endif
 
+  if (sim.collisions() && ImGui::CollapsingHeader("Contacts", ImGuiTreeNodeFlags_DefaultOpen)) {
+    // Which pieces knock together (contact_tally.hpp): the pairs touching at the last step, then those
+    // that touched most often since the mobile was loaded or reset.
+    constexpr std::size_t kShown = 6;
+    const std::vector<ContactTally::Pair> pairs = session->contact_tally().pairs();
+    std::size_t now = 0;
+    for (const ContactTally::Pair& p : pairs) now += p.last == session->last_step_time();
+    ImGui::Text("pairs touching now: %zu, so far: %zu", now, pairs.size());
+    for (std::size_t k = 0; k < pairs.size() && k < kShown; ++k) {
+      const ContactTally::Pair& p = pairs[k];
+      const bool touching = p.last == session->last_step_time();
+      ImGui::TextColored(touching ? ImVec4(1.0f, 0.55f, 0.4f, 1) : ImVec4(0.75f, 0.75f, 0.75f, 1), "%s - %s",
+                         model.names[p.a].c_str(), model.names[p.b].c_str());
+      ImGui::SameLine();
+      ImGui::TextDisabled("%lld steps, from %.1f s", p.steps, p.first);
+    }
+    if (pairs.size() > kShown) ImGui::TextDisabled("... and %zu more", pairs.size() - kShown);
+    if (ImGui::Button("Clear")) session->clear_contacts();
+  }
+
   if (ImGui::CollapsingHeader("View")) {
     ImGui::Checkbox("shadows (S)", &shadows);
     static const int kSamples[] = {0, 2, 4, 8};
