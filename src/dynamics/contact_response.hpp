@@ -87,12 +87,13 @@ class ContactResponse {
   // set to the penetration-removing pseudo-velocity; `has_pseudo` says whether it is non-zero.
   // `pose` also holds the velocities the step started from, before its first half kick; `again` says
   // that this is the step's second resolve, after the first one's impulses were added to `velocity`.
-  // Both are for the report's energy_change: the energy the impulses change is weighed at the step's
-  // start velocities (plus the first resolve's change when `again`), not at `velocity`. The split kick
-  // makes the difference: a piece resting on another falls by (h/2) g in the first half kick, the
-  // impulse stops that and the second half kick starts the fall again, so the piece keeps its energy
-  // from step to step, yet at the half-kicked velocity the impulse takes m (g h)^2 / 2 out of it. For
-  // constant forces the energy over the step changes by exactly dv^T M v_start + dv^T M dv / 2.
+  // Both are for the report's energy_change: the energy the impulses change is weighed at the step's start
+  // velocities (plus the first resolve's change when `again`), not at `velocity`. The split kick makes the
+  // difference: a piece resting on another gains (h/2) g of downward speed in the first half kick, the
+  // impulse stops that and the second half kick starts the fall again, so the piece keeps its energy from
+  // step to step, yet at the half-kicked velocity the impulse takes m (g h)^2 / 2 out of it. For constant
+  // forces (two equal half kicks) and leaving the joints' own impulses aside, the energy over the step
+  // changes by exactly dv^T M v_start + dv^T M dv / 2.
   ContactStepReport resolve(const State& pose, TreeSolver& solver, const std::vector<Contact>& contacts, double h,
                             std::vector<Vec3>& velocity, std::vector<Vec3>& angular, std::vector<Vec6>& pseudo,
                             bool& has_pseudo, bool again = false);
