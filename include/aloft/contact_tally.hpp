@@ -39,10 +39,11 @@ class ContactTally {
   long long steps_touching() const { return steps_touching_; }
 
  private:
-  std::vector<Pair> pairs_;                           // in the order first seen
-  std::vector<long long> counted_at_;                 // per pair: the last step (add_step call) it counted in
   // The pair (a, b), added if new, counted in this step (steps_) if not yet.
   Pair& count(int a, int b, double time);
+
+  std::vector<Pair> pairs_;                           // in the order first seen
+  std::vector<long long> counted_at_;                 // per pair: the last step (add_step call) it counted in
   std::unordered_map<long long, int> index_of_;       // a * 2^32 + b -> index in pairs_
   long long steps_ = 0;                               // add_step calls so far
   long long steps_touching_ = 0;
