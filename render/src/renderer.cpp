@@ -17,6 +17,7 @@ constexpr float kFloorColor[3] = {0.60f, 0.58f, 0.55f};   // pale concrete
 constexpr float kWallColor[3] = {0.84f, 0.82f, 0.78f};    // warm white
 constexpr float kBackground[3] = {0.16f, 0.16f, 0.17f};   // beyond the room (seen from behind the wall)
 constexpr float kMobileSpecular = 0.35f, kMobileShininess = 48.0f;  // painted steel
+constexpr float kGlowingHighlight = 0.6f;  // DrawOptions::glowing: a softer glow than the grabbed piece's 1
 constexpr float kRoomSpecular = 0.03f, kRoomShininess = 8.0f;       // matt paint
 // Soft-shadow filter radius as a fraction of the shadow map's width (with 1024 texels: 2.5 texels).
 constexpr float kShadowRadius = 0.0025f;
@@ -403,10 +404,10 @@ struct Renderer::Impl {
   }
 
   void draw_lit_mobile(GlProgram& program, const State& state, const OrbitCamera& camera, const Mat4f& view_proj,
-                       const Mat4f& light_vp, int highlighted) {
+                       const Mat4f& light_vp, const DrawOptions& options) {
     setup(program, camera, view_proj, light_vp);
     glUniform2f(program.uniform("u_material"), kMobileSpecular, kMobileShininess);
-    draw_mobile(program, state, true, highlighted);
+    draw_mobile(program, state, &options);
   }
 
   // The shadow map: depth of the mobile as the key light sees it (clear without the mobile: nothing
@@ -427,7 +428,7 @@ struct Renderer::Impl {
     glPolygonOffset(2.0f, 4.0f);  // against self-shadowing acne on lit faces
     depth.use();
     set_mat4(depth.uniform("u_light_view_proj"), light_vp);
-    if (options.mobile) draw_mobile(depth, state, false, -1);
+    if (options.mobile) draw_mobile(depth, state, nullptr);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target_fbo));
   }
@@ -496,15 +497,19 @@ struct Renderer::Impl {
     glDisable(GL_BLEND);
   }
 
-  void draw_mobile(GlProgram& program, const State& state, bool with_color, int highlighted) {
+  // With `colored` (the lit pass), each component in its colour and with its glow: full for the
+  // highlighted one, kGlowingHighlight for the glowing ones; without (the shadow map's depth), shapes only.
+  void draw_mobile(GlProgram& program, const State& state, const DrawOptions* colored) {
     glBindVertexArray(mobile_vao);
     const int n = std::min<int>(static_cast<int>(ranges.size()), static_cast<int>(state.position.size()));
     for (int i = 0; i < n; ++i) {
       if (ranges[i].second == 0) continue;
       set_mat4(program.uniform("u_model"), rigid_transform(state.position[i], state.orientation[i]));
-      if (with_color) {
+      if (colored) {
         glUniform3fv(program.uniform("u_color"), 1, &colors[3 * i]);
-        glUniform1f(program.uniform("u_highlight"), i == highlighted ? 1.0f : 0.0f);
+        const bool glowing = static_cast<std::size_t>(i) < colored->glowing.size() && colored->glowing[i] != 0;
+        glUniform1f(program.uniform("u_highlight"),
+                    i == colored->highlighted ? 1.0f : glowing ? kGlowingHighlight : 0.0f);
       }
       glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].second);
     }
@@ -579,7 +584,7 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, int width, in
   const int shadowed = options.shadows ? 1 : 0;
 
   // The mobile first: it hides part of the room, so fewer room pixels get shaded.
-  if (options.mobile) m.draw_lit_mobile(*m.lit[0][shadowed], state, camera, view_proj, light_vp, options.highlighted);
+  if (options.mobile) m.draw_lit_mobile(*m.lit[0][shadowed], state, camera, view_proj, light_vp, options);
 
   if (options.room) {
     // Shadow lookups are the costliest part of a frame on a software rasteriser, so only the rectangle
@@ -702,7 +707,7 @@ void Renderer::draw(const State& state, const OrbitCamera& camera, FrameTarget& 
   }
   glActiveTexture(GL_TEXTURE0);
   if (options.mobile)
-    m.draw_lit_mobile(*m.lit[0][options.shadows ? 1 : 0], state, camera, view_proj, light_vp, options.highlighted);
+    m.draw_lit_mobile(*m.lit[0][options.shadows ? 1 : 0], state, camera, view_proj, light_vp, options);
   m.draw_lines(lines, view_proj);
   if (antialias) target.pending_resolve_ = std::move(regions);
   for (GLenum unit : {GL_TEXTURE2, GL_TEXTURE1, GL_TEXTURE0}) {

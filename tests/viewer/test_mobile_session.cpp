@@ -177,8 +177,13 @@ TEST_F(Session, CountsThePairsThatTouchAndStartsAfreshOnReset) {
   EXPECT_EQ(session.model().names[pairs[0].b], "right");
   EXPECT_GT(pairs[0].steps, 1000);
   EXPECT_EQ(pairs[0].last, session.last_step_time()) << "touching now";
+  std::vector<std::uint8_t> touching;
+  session.touching_now(touching);
+  EXPECT_EQ(touching, (std::vector<std::uint8_t>{0, 1, 1}));  // hook, left, right: the glow's pieces
   session.reset();
   EXPECT_TRUE(session.contact_tally().pairs().empty());
+  session.touching_now(touching);
+  EXPECT_EQ(touching, (std::vector<std::uint8_t>{0, 0, 0}));
   session.single_step();  // at rest in the drawn pose, 10 degrees apart: nothing touches
   EXPECT_TRUE(session.contact_tally().pairs().empty());
 }

@@ -145,6 +145,52 @@ TEST_F(RenderFastPath, CacheFollowsTheCamera) {
   expect_same_picture(rested, full);
 }
 
+// DrawOptions::glowing (the viewer's pieces touching another): the glowing piece is tinted, more softly
+// than the grabbed one's glow, and nothing else changes (its shadow neither).
+TEST_F(RenderFastPath, AGlowingPieceIsTintedAndNothingElse) {
+  const Model model = load_mobile(test::preset_path("steel-fish"));
+  Renderer renderer;
+  renderer.set_model(model);
+  const State state = pushed_fish(model);
+  const OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
+  FrameTarget target;
+  target.resize(kWidth, kHeight, 4);
+  DrawOptions plain;
+  plain.reuse_background = false;
+  const int leaf = 3;  // "O3 white leaf": a large plate, well in view
+  DrawOptions glowing = plain, grabbed = plain;
+  glowing.glowing.assign(static_cast<std::size_t>(model.count), 0);
+  glowing.glowing[leaf] = 1;
+  grabbed.highlighted = leaf;
+
+  const Pixels none = draw(renderer, target, state, camera, plain);
+  const Pixels glow = draw(renderer, target, state, camera, glowing);
+  const Pixels grab = draw(renderer, target, state, camera, grabbed);
+  // All zero is no glow at all, bit for bit.
+  DrawOptions zeros = plain;
+  zeros.glowing.assign(static_cast<std::size_t>(model.count), 0);
+  EXPECT_EQ(compare(none, draw(renderer, target, state, camera, zeros), 0).largest, 0);
+  // The leaf's pixels change: over 100 of them (192 seen, 8e-4 of the picture; the leaf is turned
+  // nearly edge-on in this pose).
+  EXPECT_GT(compare(none, glow, 3).beyond, 100.0 / (kWidth * kHeight));
+  // Only where the grabbed leaf's glow also changes the picture (the same piece, not its shadow nor any
+  // other piece), and by less.
+  long long changed = 0, outside = 0, softer = 0;
+  for (std::size_t i = 0; i + 3 < none.size(); i += 4) {
+    int by_glow = 0, by_grab = 0;
+    for (int c = 0; c < 3; ++c) {
+      by_glow = std::max(by_glow, std::abs(int(glow[i + c]) - int(none[i + c])));
+      by_grab = std::max(by_grab, std::abs(int(grab[i + c]) - int(none[i + c])));
+    }
+    if (by_glow <= 3) continue;
+    ++changed;
+    outside += by_grab == 0;
+    softer += by_glow < by_grab;
+  }
+  EXPECT_EQ(outside, 0);
+  EXPECT_GT(softer, 0.9 * changed);
+}
+
 // A thin dark wire, slanted, in front of the wall: with anti-aliasing its edge pixels take colours
 // between the wire's and the wall's (partial coverage), which the aliased picture lacks; the wire's
 // total darkening (its coverage summed over the picture) stays about the same.

@@ -326,6 +326,12 @@ double MobileSession::advance(double wall_seconds, double budget_seconds) {
   return sim_->state().time - start_time;
 }
 
+void MobileSession::touching_now(std::vector<std::uint8_t>& touching) const {
+  touching.assign(static_cast<std::size_t>(model_->count), 0);
+  for (const ContactTally::Pair& p : contacts_.pairs())
+    if (p.last == last_step_time()) touching[static_cast<std::size_t>(p.a)] = touching[static_cast<std::size_t>(p.b)] = 1;
+}
+
 void MobileSession::single_step() {
   physics_seconds_ = wind_seconds_ = 0;
   if (!failed()) step_once();

@@ -4,6 +4,7 @@
 // spring, and the pacing of physics against the wall clock. Reloading a file that has become broken
 // keeps the old mobile running and records the error for the window to show.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -121,6 +122,9 @@ class MobileSession {
   const ContactTally& contact_tally() const { return contacts_; }
   double last_step_time() const { return sim_->state().time; }
   void clear_contacts() { contacts_ = ContactTally{}; }
+  // Per component: 1 when it touched another at the last step (a pair of contact_tally() with `last` at
+  // last_step_time()), else 0. Resized to the component count; all 0 with collisions off.
+  void touching_now(std::vector<std::uint8_t>& touching) const;
 
   // Compute time of the last advance(), s: physics (solver) and wind (occlusion and forces).
   double last_physics_seconds() const { return physics_seconds_; }

@@ -364,6 +364,7 @@ int run_viewer(const ViewerOptions& options) {
       draw.shadows = v.shadows;
       draw.mobile = !options.hide_mobile;
       draw.highlighted = v.session->grabbed() ? v.session->grabbed()->component : -1;
+      if (v.glow_touching) v.session->touching_now(draw.glowing);
       renderer.draw(v.session->simulation().state(), v.camera, fb_w, fb_h, draw, v.overlay_lines());
       target.resolve();
       const bool last_test_frame = options.frames > 0 && frame + 1 >= options.frames;

@@ -335,6 +335,8 @@ void ViewerState::draw_panel() {
     }
     if (pairs.size() > kShown) ImGui::TextDisabled("... and %zu more", pairs.size() - kShown);
     if (ImGui::Button("Clear")) session->clear_contacts();
+    ImGui::SameLine();
+    ImGui::Checkbox("glow where they touch", &glow_touching);
   }
 
   if (ImGui::CollapsingHeader("View")) {

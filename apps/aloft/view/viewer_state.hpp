@@ -55,6 +55,7 @@ struct ViewerState {
   bool show_panel = true;
   bool show_help = false;
   bool shadows = true;
+  bool glow_touching = true;  // pieces touching another at the last step drawn with a glow (Contacts panel)
   int samples = 4;
   bool auto_quality_done = false;    // anti-aliasing was switched off once for speed (never again)
   double slow_seconds = 0;           // how long frames have been slower than 20 ms

@@ -6,6 +6,7 @@
 // framebuffer is bound (everything shaded every time).
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct DrawOptions {
   bool room = true;               // floor and wall
   bool mobile = true;             // false: the empty room (tests compare against it)
   int highlighted = -1;           // component drawn with a warm glow (the grabbed one), -1: none
+  // Per component: non-zero to draw it with a softer glow of the same colour (the viewer's pieces touching
+  // another); empty for none.
+  std::vector<std::uint8_t> glowing;
   int shadow_map_size = 1024;     // texels per side (the light's frustum is fitted to the mobile)
   // Into a FrameTarget: keep the room shaded in its cached background while the camera, size and model
   // stay the same, and anti-alias only the mobile's rectangle. false: shade the whole picture anew
