@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "aloft/contact_tally.hpp"
 #include "aloft/render/frame_target.hpp"
 #include "aloft/render/headless_context.hpp"
 #include "aloft/render/image_output.hpp"
@@ -70,6 +71,7 @@ Runner add_render(CLI::App& app) {
     double fps = 30;
     int samples = 4;
     bool no_shadows = false;
+    bool glow_touching = false;
     bool quiet = false;
     CameraFlags camera;
     WindOptions wind;
@@ -95,6 +97,8 @@ Runner add_render(CLI::App& app) {
       ->capture_default_str()
       ->check(integer_in(0, 16));
   sub->add_flag("--no-shadows", o->no_shadows, "Draw without shadows");
+  sub->add_flag("--glow-touching", o->glow_touching,
+                "Draw the pieces that touched another since the frame before (within 1/fps s) with a soft glow");
   sub->add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
   o->camera.add_to(sub);
   add_wind_options(sub, o->wind);
@@ -109,6 +113,7 @@ Runner add_render(CLI::App& app) {
       "  aloft render mobiles/steel-fish.json -t 4 --fps 15 --width 480 --height 270 --out fish.gif\n"
       "  aloft render mobiles/steel-fish.json -t 2 --out frames/ --yaw 30 --pitch 20 --distance 5\n"
       "  aloft render mobiles/steel-fish.json -t 8 --wind 2 --out breeze.mp4   # a steady breath from the front\n"
+      "  aloft render big.json -t 10 --wind 3 --glow-touching --out knocks.mp4   # which pieces knock together\n"
       "\n"
       "Wind: as in 'aloft simulate' (--wind, --wind-speed, --wind-audio and the source flags); the mobile\n"
       "file's \"wind_sources\" blow too, unless --no-file-wind.\n"
@@ -119,6 +124,10 @@ Runner add_render(CLI::App& app) {
     Simulation sim(model);
     WindSet wind(model, loaded.spec, sim.state(), o->wind, sim.timestep());
     long long steps = 0;
+    const double frame_time = 1 / o->fps;
+    // --glow-touching: the pairs that touched in the steps of the frame interval being stepped through
+    // (the 1/fps s before the frame; a still's too), taken and cleared as each frame is drawn.
+    ContactTally touched;
     // Physics up to simulated time t: each wind's occlusion refreshed every refresh_every steps, the
     // forces applied at every step (as 'aloft simulate' does).
     const auto advance_to = [&](double t) {
@@ -126,6 +135,8 @@ Runner add_render(CLI::App& app) {
         wind.apply(steps, sim.state(), sim.timestep(), sim.loads());
         if (!sim.step()) return false;
         ++steps;
+        if (o->glow_touching && sim.collisions() && sim.state().time > t - frame_time + 0.5 * sim.timestep())
+          touched.add_step(sim.contacts(), sim.pushed_pairs(), sim.state().time);
       }
       return true;
     };
@@ -143,11 +154,14 @@ Runner add_render(CLI::App& app) {
 
     render::FrameSink sink(o->out, o->width, o->height, o->fps);
     const long long frames = sink.wants_every_frame() ? std::max(1LL, std::llround(o->duration * o->fps)) : 1;
-    const double frame_time = 1 / o->fps;
     std::vector<std::uint8_t> pixels;
     RenderProgress progress(!o->quiet, frames);
     const auto start = std::chrono::steady_clock::now();
     const auto draw_frame = [&] {
+      if (o->glow_touching) {
+        touched.components_touching_since(-INFINITY, model.count, options.glowing);
+        touched = ContactTally{};
+      }
       target.bind();
       renderer.draw(sim.state(), camera, o->width, o->height, options);
       target.resolve();

@@ -7,6 +7,7 @@
 // first alone misses pieces that rest against each other with no impulse in a step; the second, a knock
 // stopped and turned back by a speculative contact before its pieces were that close at a step's start.)
 
+#include <cstdint>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -37,6 +38,9 @@ class ContactTally {
   std::vector<Pair> pairs() const;
   // The steps in which some pair touched.
   long long steps_touching() const { return steps_touching_; }
+  // Per component (`touching` resized to `count`): 1 for both of every pair whose last touch was at or
+  // after `since` (s), else 0. (The viewer's and the renderer's glow on touching pieces.)
+  void components_touching_since(double since, int count, std::vector<std::uint8_t>& touching) const;
 
  private:
   // The pair (a, b), added if new, counted in this step (steps_) if not yet.

@@ -17,7 +17,9 @@ constexpr float kFloorColor[3] = {0.60f, 0.58f, 0.55f};   // pale concrete
 constexpr float kWallColor[3] = {0.84f, 0.82f, 0.78f};    // warm white
 constexpr float kBackground[3] = {0.16f, 0.16f, 0.17f};   // beyond the room (seen from behind the wall)
 constexpr float kMobileSpecular = 0.35f, kMobileShininess = 48.0f;  // painted steel
-constexpr float kGlowingHighlight = 0.6f;  // DrawOptions::glowing: a softer glow than the grabbed piece's 1
+// DrawOptions::glowing: stronger than the grabbed piece's 1 (0.72 of the way to the glow's orange against
+// 0.45), so that a touching piece stands out among a generated mobile's many colours.
+constexpr float kGlowingHighlight = 1.6f;
 constexpr float kRoomSpecular = 0.03f, kRoomShininess = 8.0f;       // matt paint
 // Soft-shadow filter radius as a fraction of the shadow map's width (with 1024 texels: 2.5 texels).
 constexpr float kShadowRadius = 0.0025f;

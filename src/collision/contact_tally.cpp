@@ -41,6 +41,12 @@ void ContactTally::add_step(const std::vector<Contact>& contacts, const std::vec
   steps_touching_ += any;
 }
 
+void ContactTally::components_touching_since(double since, int count, std::vector<std::uint8_t>& touching) const {
+  touching.assign(static_cast<std::size_t>(count), 0);
+  for (const Pair& p : pairs_)
+    if (p.last >= since) touching[static_cast<std::size_t>(p.a)] = touching[static_cast<std::size_t>(p.b)] = 1;
+}
+
 std::vector<ContactTally::Pair> ContactTally::pairs() const {
   std::vector<Pair> sorted = pairs_;
   std::sort(sorted.begin(), sorted.end(), [](const Pair& x, const Pair& y) {

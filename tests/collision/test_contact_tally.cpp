@@ -2,6 +2,7 @@
 // leaning balls touch in every step from their first knock on.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <vector>
 
@@ -50,6 +51,12 @@ TEST(ContactTally, CountsEachPairOncePerStepWithinTheTouchingGap) {
   EXPECT_EQ(pairs[1].first, 0.001);
   EXPECT_EQ(pairs[1].last, 0.002);
   EXPECT_DOUBLE_EQ(pairs[1].deepest, 1e-5);
+  // The components of the pairs touching at or after a time: (0, 3) last at 0.004, (1, 2) at 0.002.
+  std::vector<std::uint8_t> touching;
+  tally.components_touching_since(0.003, 5, touching);
+  EXPECT_EQ(touching, (std::vector<std::uint8_t>{1, 0, 0, 1, 0}));
+  tally.components_touching_since(0.002, 5, touching);
+  EXPECT_EQ(touching, (std::vector<std::uint8_t>{1, 1, 1, 1, 0}));
 }
 
 TEST(ContactTally, CountsAPairPushedApartThoughNeverThatClose) {

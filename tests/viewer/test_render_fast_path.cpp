@@ -145,8 +145,8 @@ TEST_F(RenderFastPath, CacheFollowsTheCamera) {
   expect_same_picture(rested, full);
 }
 
-// DrawOptions::glowing (the viewer's pieces touching another): the glowing piece is tinted, more softly
-// than the grabbed one's glow, and nothing else changes (its shadow neither).
+// DrawOptions::glowing (pieces touching another): the glowing piece is tinted, more strongly than the
+// grabbed one's glow, and nothing else changes (its shadow neither).
 TEST_F(RenderFastPath, AGlowingPieceIsTintedAndNothingElse) {
   const Model model = load_mobile(test::preset_path("steel-fish"));
   Renderer renderer;
@@ -174,8 +174,8 @@ TEST_F(RenderFastPath, AGlowingPieceIsTintedAndNothingElse) {
   // nearly edge-on in this pose).
   EXPECT_GT(compare(none, glow, 3).beyond, 100.0 / (kWidth * kHeight));
   // Only where the grabbed leaf's glow also changes the picture (the same piece, not its shadow nor any
-  // other piece), and by less.
-  long long changed = 0, outside = 0, softer = 0;
+  // other piece), and by more.
+  long long changed = 0, outside = 0, stronger = 0;
   for (std::size_t i = 0; i + 3 < none.size(); i += 4) {
     int by_glow = 0, by_grab = 0;
     for (int c = 0; c < 3; ++c) {
@@ -185,10 +185,10 @@ TEST_F(RenderFastPath, AGlowingPieceIsTintedAndNothingElse) {
     if (by_glow <= 3) continue;
     ++changed;
     outside += by_grab == 0;
-    softer += by_glow < by_grab;
+    stronger += by_glow > by_grab;
   }
   EXPECT_EQ(outside, 0);
-  EXPECT_GT(softer, 0.9 * changed);
+  EXPECT_GT(stronger, 0.9 * changed);
 }
 
 // A thin dark wire, slanted, in front of the wall: with anti-aliasing its edge pixels take colours

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "support/leaning_balls.hpp"
 #include "support/run_aloft.hpp"
 
 namespace {
@@ -222,6 +223,28 @@ TEST_F(Viewer, HeadlessRenderPngShowsTheMobile) {
   const ColourCounts c = count_colours(image);
   EXPECT_GT(c.red, 10);
   EXPECT_GT(c.black, 50);
+}
+
+// --glow-touching: at 3 s the leaning balls rest on each other, so the still shows them glowing; nothing
+// else in the picture changes (the hook's bar and the room are the same).
+TEST_F(Viewer, HeadlessRenderGlowsThePiecesThatTouch) {
+  std::ofstream(dir_ / "balls.json", std::ios::binary) << aloft::test::kLeaningBalls;
+  const std::string common = "balls.json --duration 3 --width 320 --height 180 --no-shadows -q";
+  ASSERT_EQ(render(common + " --out plain.png").code, 0);
+  ASSERT_EQ(render(common + " --glow-touching --out glow.png").code, 0);
+  const Image plain = load_png(dir_ / "plain.png"), glow = load_png(dir_ / "glow.png");
+  // The two balls: a few hundred pixels at this size (they are 6 cm across in a frame about 1 m wide).
+  EXPECT_GT(differing_pixels(plain, glow), 100);
+  // Warmer where they differ: the glow tints towards orange (red up against blue).
+  long long warmer = 0, differing = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const unsigned char *p = plain.at(x, y), *q = glow.at(x, y);
+      if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) continue;
+      ++differing;
+      warmer += (q[0] - q[2]) > (p[0] - p[2]);
+    }
+  EXPECT_GT(warmer, 0.9 * differing);
 }
 
 TEST_F(Viewer, HeadlessRenderRejectsAnUnknownOutput) {

@@ -327,9 +327,7 @@ double MobileSession::advance(double wall_seconds, double budget_seconds) {
 }
 
 void MobileSession::touching_now(std::vector<std::uint8_t>& touching) const {
-  touching.assign(static_cast<std::size_t>(model_->count), 0);
-  for (const ContactTally::Pair& p : contacts_.pairs())
-    if (p.last == last_step_time()) touching[static_cast<std::size_t>(p.a)] = touching[static_cast<std::size_t>(p.b)] = 1;
+  contacts_.components_touching_since(last_step_time(), model_->count, touching);
 }
 
 void MobileSession::single_step() {

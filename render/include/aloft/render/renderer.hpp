@@ -23,8 +23,8 @@ struct DrawOptions {
   bool room = true;               // floor and wall
   bool mobile = true;             // false: the empty room (tests compare against it)
   int highlighted = -1;           // component drawn with a warm glow (the grabbed one), -1: none
-  // Per component: non-zero to draw it with a softer glow of the same colour (the viewer's pieces touching
-  // another); empty for none.
+  // Per component: non-zero to draw it with a stronger glow of the same colour (pieces touching another,
+  // in the viewer and `aloft render --glow-touching`); empty for none.
   std::vector<std::uint8_t> glowing;
   int shadow_map_size = 1024;     // texels per side (the light's frustum is fitted to the mobile)
   // Into a FrameTarget: keep the room shaded in its cached background while the camera, size and model
