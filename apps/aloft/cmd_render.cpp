@@ -98,7 +98,7 @@ Runner add_render(CLI::App& app) {
       ->check(integer_in(0, 16));
   sub->add_flag("--no-shadows", o->no_shadows, "Draw without shadows");
   sub->add_flag("--glow-touching", o->glow_touching,
-                "Draw the pieces that touched another since the frame before (within 1/fps s) with a soft glow");
+                "Draw the pieces that touched another since the frame before (within 1/fps s) with a warm glow");
   sub->add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
   o->camera.add_to(sub);
   add_wind_options(sub, o->wind);

@@ -85,7 +85,7 @@ uniform vec3 u_eye;              // world, m
 uniform vec3 u_light_pos;        // world, m
 uniform vec3 u_light_dir;        // unit, the spot's axis
 uniform vec2 u_material;         // specular strength, shininess
-uniform float u_highlight;       // 0..1: tint towards a warm glow (the grabbed component)
+uniform float u_highlight;       // 0..2.2: tint towards a warm glow (1: the grabbed component, 1.6: touching)
 uniform vec2 u_corner;           // floor height y and wall plane z (m), for the corner darkening
 layout(location = 0) out vec4 o_color;
 #ifdef BACKGROUND
