@@ -49,8 +49,8 @@ void print_collision_summary(const Model& model, const Simulation& sim, const Co
                 ContactTally::kTouchingGap * 1e3);
     return;
   }
-  std::printf("touching pairs    %zu (pushed apart, or within %.2g mm), in %lld steps; the most often:\n", touched.size(),
-              ContactTally::kTouchingGap * 1e3, tally.steps_touching());
+  std::printf("touching pairs    %zu (pushed apart, or within %.2g mm), in %lld steps; the most often:\n",
+              touched.size(), ContactTally::kTouchingGap * 1e3, tally.steps_touching());
   for (std::size_t k = 0; k < touched.size() && k < kPairsShown; ++k) {
     const ContactTally::Pair& p = touched[k];
     std::printf("                  '%s' and '%s': %lld steps, %.3f to %.3f s, overlap up to %.3f mm\n",

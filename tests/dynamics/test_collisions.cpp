@@ -381,7 +381,8 @@ TEST(Collisions, EnergyTakenOutIsTheEnergyLost) {
   ASSERT_TRUE(sim.advance(3.0)) << sim.failure()->message;
   const double lost = start - (kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()));
   const double removed = sim.collision_statistics().energy_removed - removed_before;
-  std::printf("generated-127 left alone 3 s: %lld contact impulses, energy lost %.5g J, taken out by the contacts %.5g J\n",
+  std::printf("generated-127 left alone 3 s: %lld contact impulses, energy lost %.5g J, taken out by the "
+              "contacts %.5g J\n",
               sim.collision_statistics().impulses - impulses_before, lost, removed);
   EXPECT_GT(sim.collision_statistics().impulses - impulses_before, 1000) << "the pieces should keep knocking";
   EXPECT_GT(lost, 0.02) << "the knocks should take a good part of the energy out";
