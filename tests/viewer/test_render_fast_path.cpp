@@ -67,6 +67,23 @@ State pushed_fish(const Model& model) {
   return sim.state();
 }
 
+// The Steel Fish pushed (above), a renderer with its meshes, the framing camera and a 4x multisampled
+// target: the scene of the tests below. Needs a current GL context (the fixture's).
+struct PushedFishScene {
+  Model model = load_mobile(test::preset_path("steel-fish"));
+  Renderer renderer;
+  State state;
+  OrbitCamera camera;
+  FrameTarget target;
+  PushedFishScene() {
+    renderer.set_model(model);
+    state = pushed_fish(model);
+    camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
+    target.resize(kWidth, kHeight, 4);
+  }
+  Pixels draw(const DrawOptions& options) { return render::draw(renderer, target, state, camera, options); }
+};
+
 // See SamePictureAsShadingEverythingAnew for the tolerances.
 void expect_same_picture(const Pixels& fast, const Pixels& reference) {
   const Difference d = compare(fast, reference, 3);
@@ -87,23 +104,17 @@ class RenderFastPath : public ::testing::Test {
 };
 
 TEST_F(RenderFastPath, SamePictureAsShadingEverythingAnew) {
-  const Model model = load_mobile(test::preset_path("steel-fish"));
-  Renderer renderer;
-  renderer.set_model(model);
-  const State state = pushed_fish(model);
-  const OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
-  FrameTarget target;
-  target.resize(kWidth, kHeight, 4);
+  PushedFishScene scene;
   DrawOptions fast, reference;
   reference.reuse_background = false;
 
-  const Pixels first = draw(renderer, target, state, camera, fast);
-  const Pixels again = draw(renderer, target, state, camera, fast);   // from the cached background
-  const Pixels full = draw(renderer, target, state, camera, reference);
+  const Pixels first = scene.draw(fast);
+  const Pixels again = scene.draw(fast);   // from the cached background
+  const Pixels full = scene.draw(reference);
   // The picture must show something besides the room: the mobile and its shadow differ from the room.
   DrawOptions empty_room = reference;
   empty_room.mobile = false;
-  const Pixels room = draw(renderer, target, state, camera, empty_room);
+  const Pixels room = scene.draw(empty_room);
   EXPECT_GT(compare(full, room, 24).beyond, 0.01);
 
   // The cache changes nothing: the second frame is the first, bit for bit.
@@ -121,23 +132,17 @@ TEST_F(RenderFastPath, SamePictureAsShadingEverythingAnew) {
 }
 
 TEST_F(RenderFastPath, CacheFollowsTheCamera) {
-  const Model model = load_mobile(test::preset_path("steel-fish"));
-  Renderer renderer;
-  renderer.set_model(model);
-  const State state = pushed_fish(model);
-  OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
-  FrameTarget target;
-  target.resize(kWidth, kHeight, 4);
+  PushedFishScene scene;
   DrawOptions fast, reference;
   reference.reuse_background = false;
 
-  const Pixels before = draw(renderer, target, state, camera, fast);
-  camera.orbit(0.3, 0.1);
+  const Pixels before = scene.draw(fast);
+  scene.camera.orbit(0.3, 0.1);
   // While the camera moves the background is redrawn without anti-aliasing; the first frame with the
   // camera at rest draws it again with anti-aliasing, and then it matches the reference (as above).
-  const Pixels moving = draw(renderer, target, state, camera, fast);
-  const Pixels rested = draw(renderer, target, state, camera, fast);
-  const Pixels full = draw(renderer, target, state, camera, reference);
+  const Pixels moving = scene.draw(fast);
+  const Pixels rested = scene.draw(fast);
+  const Pixels full = scene.draw(reference);
   EXPECT_GT(compare(before, rested, 24).beyond, 0.05);   // the view did change (the room moved)
   // Moving: the floor-wall line aliased (a pixel or two per column, under 1 % of the picture; 0.2 %
   // seen), no stale room (that would be most of the picture, as `before` against `rested` shows).
@@ -148,28 +153,23 @@ TEST_F(RenderFastPath, CacheFollowsTheCamera) {
 // DrawOptions::glowing (pieces touching another): the glowing piece is tinted, more strongly than the
 // grabbed one's glow, and nothing else changes (its shadow neither).
 TEST_F(RenderFastPath, AGlowingPieceIsTintedAndNothingElse) {
-  const Model model = load_mobile(test::preset_path("steel-fish"));
-  Renderer renderer;
-  renderer.set_model(model);
-  const State state = pushed_fish(model);
-  const OrbitCamera camera = framing_camera(renderer.scene(), double(kWidth) / kHeight);
-  FrameTarget target;
-  target.resize(kWidth, kHeight, 4);
+  PushedFishScene scene;
+  const int count = scene.model.count;
   DrawOptions plain;
   plain.reuse_background = false;
   const int leaf = 3;  // "O3 white leaf": a large plate, well in view
   DrawOptions glowing = plain, grabbed = plain;
-  glowing.glowing.assign(static_cast<std::size_t>(model.count), 0);
+  glowing.glowing.assign(static_cast<std::size_t>(count), 0);
   glowing.glowing[leaf] = 1;
   grabbed.highlighted = leaf;
 
-  const Pixels none = draw(renderer, target, state, camera, plain);
-  const Pixels glow = draw(renderer, target, state, camera, glowing);
-  const Pixels grab = draw(renderer, target, state, camera, grabbed);
+  const Pixels none = scene.draw(plain);
+  const Pixels glow = scene.draw(glowing);
+  const Pixels grab = scene.draw(grabbed);
   // All zero is no glow at all, bit for bit.
   DrawOptions zeros = plain;
-  zeros.glowing.assign(static_cast<std::size_t>(model.count), 0);
-  EXPECT_EQ(compare(none, draw(renderer, target, state, camera, zeros), 0).largest, 0);
+  zeros.glowing.assign(static_cast<std::size_t>(count), 0);
+  EXPECT_EQ(compare(none, scene.draw(zeros), 0).largest, 0);
   // The leaf's pixels change: over 100 of them (192 seen, 8e-4 of the picture; the leaf is turned
   // nearly edge-on in this pose).
   EXPECT_GT(compare(none, glow, 3).beyond, 100.0 / (kWidth * kHeight));
