@@ -208,7 +208,7 @@ Runner add_simulate(CLI::App& app) {
 
     std::unique_ptr<Trajectory> csv;
     if (!o->out.empty()) csv = std::make_unique<Trajectory>(o->out, model);
-    if (!o->contacts_out.empty()) check_writable(o->contacts_out);
+    if (!o->contacts_out.empty()) write_file(o->contacts_out, "");  // a CSV that cannot be written fails here
     ContactTally tally;
 
     const State rest = rest_state(model);

@@ -3,9 +3,7 @@
 #include "contact_report.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 
 #include "common.hpp"
 
@@ -62,11 +60,6 @@ void print_collision_summary(const Model& model, const Simulation& sim, const Co
   if (!csv_path.empty()) std::printf("contact pairs     %s (%zu pairs)\n", csv_path.c_str(), touched.size());
 }
 
-void check_writable(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file || std::fclose(file) != 0) throw Failure("cannot write " + path + ": " + std::strerror(errno));
-}
-
 void write_contact_pairs_csv(const std::string& path, const Model& model, const ContactTally& tally) {
   std::string text = "component_a,component_b,steps,first_t,last_t,deepest_overlap_m\n";
   for (const ContactTally::Pair& p : tally.pairs()) {
@@ -77,10 +70,7 @@ void write_contact_pairs_csv(const std::string& path, const Model& model, const 
     }
     text += '\n';
   }
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw Failure("cannot write " + path + ": " + std::strerror(errno));
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-  if (std::fclose(file) != 0 || !written) throw Failure("cannot write " + path + ": " + std::strerror(errno));
+  write_file(path, text);
 }
 
 }  // namespace aloft::cli

@@ -17,10 +17,6 @@ enum class CollisionsOff { kNo, kByFlag, kByFile };
 void print_collision_summary(const Model& model, const Simulation& sim, const ContactTally& tally,
                              CollisionsOff off, const std::string& csv_path);
 
-// Creates (empties) `path`, so that a run whose CSV cannot be written fails before it starts. Throws
-// Failure when it cannot.
-void check_writable(const std::string& path);
-
 // Writes every pair that touched as a CSV row: component_a,component_b,steps,first_t,last_t,
 // deepest_overlap_m (names quoted as RFC 4180 needs; times in s, the overlap in m). Throws Failure when
 // the file cannot be written.
