@@ -56,9 +56,10 @@ struct CollisionStatistics {
   long long friction_dropped = 0;     // steps where the law with friction did not converge or even that
                                       // gained (nearly dependent contacts): solved without friction, or
                                       // without impulse
-  // The contact law's work: its solves (one per resolve with contacts to solve, two when the look after
-  // the impulses finds other contacts), the contacts they were for (each solve's m: its sweeps cost
-  // O(m^2) and its collision matrix O(m^2) path sums) and their Gauss-Seidel sweeps. And the closing
+  // The contact law's work: its solves (one per resolve with contacts to solve: a (sub)step resolves once,
+  // and again, up to 4 solves in all, while the look after the impulses finds other contacts or they
+  // close a contact left out), the contacts they were for (each solve's m: its sweeps cost O(m^2) and its
+  // collision matrix O(m^2) path sums) and their Gauss-Seidel sweeps. And the closing
   // contacts beyond ContactResponse::kMaxContacts that a step left unsolved (the latest to close; the
   // next step looks at them again).
   long long law_solves = 0, law_contacts = 0, law_sweeps = 0;

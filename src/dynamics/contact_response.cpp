@@ -39,7 +39,7 @@ ContactResponse::ContactResponse(const Model& model)
       path_position_(model.count, -1),
       wrench_(model.count, Vec6::Zero()),
       du_(model.count, Vec6::Zero()),
-      first_change_(model.count, Vec6::Zero()) {}
+      earlier_change_(model.count, Vec6::Zero()) {}
 
 void ContactResponse::gather_wrenches(const std::vector<Contact>& contacts, const Eigen::VectorXd& P) {
   const int m = static_cast<int>(contacts.size());
@@ -95,8 +95,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
                                            std::vector<Vec6>& pseudo, bool& has_pseudo, bool again) {
   ContactStepReport report;
   has_pseudo = false;
-  const bool after_first = again && has_first_change_;
-  has_first_change_ = false;
+  const bool after_earlier = again && has_earlier_change_;
+  if (!again) has_earlier_change_ = false;
   if (!again) pushed_pairs_.clear();
   report.contacts = static_cast<int>(found.size());
   solver_ = &solver;
@@ -298,9 +298,9 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     const auto start_velocity = [&](int body, const Vec3& arm) {
       if (body == 0) return Vec3(Vec3::Zero());
       Vec3 v = pose.velocity[body], w = pose.angular[body];
-      if (after_first) {
-        v += first_change_[body].head<3>();
-        w += first_change_[body].tail<3>();
+      if (after_earlier) {
+        v += earlier_change_[body].head<3>();
+        w += earlier_change_[body].tail<3>();
       }
       return Vec3(v + w.cross(arm));
     };
@@ -315,13 +315,22 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   // Apply: one tree solve with G^T P gives every body's velocity change and the joint impulses.
   if (report.active > 0) {
     respond(contacts, P_);
-    for (int i = 1; i < model_.count; ++i) {
-      velocity[i] += du_[i].head<3>();
-      angular[i] += du_[i].tail<3>();
+    // Kept, summed over the step's resolves, for a later one's energy change (du_ is overwritten below
+    // and by the contact passes).
+    if (after_earlier) {
+      for (int i = 1; i < model_.count; ++i) {
+        velocity[i] += du_[i].head<3>();
+        angular[i] += du_[i].tail<3>();
+        earlier_change_[i] += du_[i];
+      }
+    } else {
+      for (int i = 1; i < model_.count; ++i) {
+        velocity[i] += du_[i].head<3>();
+        angular[i] += du_[i].tail<3>();
+      }
+      std::swap(earlier_change_, du_);
+      has_earlier_change_ = true;
     }
-    // Kept for a second resolve's energy change (du_ is overwritten below and by the contact passes).
-    std::swap(first_change_, du_);
-    has_first_change_ = !again;
   }
 
   // Split impulse: a frictionless pseudo-velocity that removes a part of each overlap beyond the slop.

@@ -86,9 +86,9 @@ class ContactResponse {
   // every step), so they are not kept. `pseudo` (per body: linear m/s, angular rad/s) is
   // set to the penetration-removing pseudo-velocity; `has_pseudo` says whether it is non-zero.
   // `pose` also holds the velocities the step started from, before its first half kick; `again` says
-  // that this is the step's second resolve, after the first one's impulses were added to `velocity`.
+  // that this is a later resolve of the step, after the earlier ones' impulses were added to `velocity`.
   // Both are for the report's energy_change: the energy the impulses change is weighed at the step's start
-  // velocities (plus the first resolve's change when `again`), not at `velocity`. The split kick makes the
+  // velocities (plus the earlier resolves' changes when `again`), not at `velocity`. The split kick makes the
   // difference: a piece resting on another gains (h/2) g of downward speed in the first half kick, the
   // impulse stops that and the second half kick starts the fall again, so the piece keeps its energy from
   // step to step, yet at the half-kicked velocity the impulse takes m (g h)^2 / 2 out of it. For constant
@@ -132,7 +132,7 @@ class ContactResponse {
   // The contacts the last resolve() solved, in the order of the matrices below.
   const std::vector<Contact>& kept() const { return kept_; }
   // The pairs of components (a < b) given a normal impulse by the step's resolves (the first, and the
-  // second when `again`; a pair may appear more than once). The contact passes' corrections are not
+  // later ones, `again`; a pair may appear more than once). The contact passes' corrections are not
   // included.
   const std::vector<std::pair<int, int>>& pushed_pairs() const { return pushed_pairs_; }
 
@@ -184,10 +184,10 @@ class ContactResponse {
   std::vector<Vec6> wrench_;   // per body, zero between uses
   std::vector<int> touched_;   // the bodies wrench_ is non-zero at (each contact's two)
   std::vector<Vec6> du_;
-  // The velocity change (per body: linear m/s, angular rad/s) of this step's first resolve, which weighs
-  // the second's energy change (resolve(), `again`); valid when has_first_change_.
-  std::vector<Vec6> first_change_;
-  bool has_first_change_ = false;
+  // The velocity change (per body: linear m/s, angular rad/s) of this step's resolves so far, which
+  // weighs a later one's energy change (resolve(), `again`); valid when has_earlier_change_.
+  std::vector<Vec6> earlier_change_;
+  bool has_earlier_change_ = false;
   std::vector<std::pair<int, int>> pushed_pairs_;
 };
 
