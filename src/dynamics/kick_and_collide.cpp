@@ -21,10 +21,11 @@ constexpr double kContactMargin = 5e-4;
 // from what it found instead of detecting again, as long as no component's margin grew by more (see
 // kick_and_collide).
 constexpr double kRecheckSlack = 1e-4;
-// The most contact solves in a step (the first; the second, on the list the look after its impulses
-// gives; and more on that list while the last solve's impulses close a contact it left out): a knock is
-// passed on across up to this many pairs within the step (a row of 5 pieces). A pair it closes beyond
-// that waits for the next step, under the step's motion check (rattle: contacts_move_slowly_enough).
+// The most contact solves in a step (the first, and one more each time the look after a solve's impulses
+// finds another list or a contact left out closing): a knock is passed on across up to this many pairs
+// within the step (a row of 5 pieces). A pair it closes beyond that waits for the next step; the last
+// look's list is what the step's motion check holds to what a step may deepen a contact (rattle:
+// contacts_move_slowly_enough).
 constexpr int kMaxSolvesPerLook = 4;
 
 // A later solve of the step's contacts (ContactResponse::resolve, `again`) added to the step's report:
@@ -156,49 +157,64 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
           work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo);
     // A knock can send a component off faster than its margin assumed: look again with the new
     // velocities, and if that finds other contacts, solve them all (what was solved needs nothing more).
-    // When no component's margin grew by more than kRecheckSlack, every contact within the new margins
-    // is in `nearby`: `aloft_step_profile` after the breeze, collisions on, needed the detector again
-    // for 38 of 979 looks on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps);
-    // with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10 and 9 (a wider first look costs more);
-    // with the slack only after a look whose contacts had impulses, for 405 and 26. Where some margins did
-    // grow more, only the pairs of those components are looked at again (find_contacts_again).
+    // `nearby` holds every contact of each pair within the sum of its components' looked_margin. While
+    // no component's margin outgrows that, the contacts within the new margins are picked from it:
+    // `aloft_step_profile` after the breeze, collisions on, needed the detector again for 38 of 979 looks
+    // on generated-127 (1000 steps) and 23 of 354 on generated-1023 (100 steps), with the first look
+    // kRecheckSlack further than the margins; with a slack of 0.05 mm for 57 and 29, with 0.25 mm for 10
+    // and 9 (a wider first look costs more); with the slack only after a look whose contacts had
+    // impulses, for 405 and 26. Where some margins do outgrow it, only the pairs of those components are
+    // looked at again (find_contacts_again), kRecheckSlack further than their margins too, and `nearby`
+    // becomes what that finds.
+    // Solved again, all of them, also when the list is the same but one the solve left out as apart now
+    // closes: the impulses knocked one of its components towards the other. (Until 2026-12-06 only another
+    // list was: on generated-1023 after the breeze, a thread 0.08 mm from its neighbour, separating at
+    // 1 mm/s and so left out, was knocked towards it at 0.71 m/s by its other contacts' impulses and began
+    // the next step 0.62 mm deep, past the thread's radius. docs/collisions.md, "A contact the knock
+    // closes".) And the look and the solve again after every solve whose impulses changed the
+    // velocities, up to kMaxSolvesPerLook solves: a knock passed along a row of pieces reaches one more
+    // pair with each solve, and a piece it sends off fast is looked at again. (Until the fourth session of
+    // 2026-12-06 a step solved twice at most and looked again only after its first solve:
+    // Collisions.AKnockIsPassedOnWithinTheStep, 4 balls on, and Collisions.AKnockPassedOnIsLookedAtAgain.)
     work.last_look_found = !work.contacts.empty();
-    if (contact_report.active > 0) {
-      bool covered = true;  // no component's margin is wider now than in the look `nearby` came from
+    for (int solves = 1; contact_report.active > 0; ++solves) {
+      bool covered = true;  // no component's margin is wider now than its pairs in `nearby` were looked for with
       for (int i = 1; i < n; ++i) {
-        const double looked =
-            work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin + 2 * slack);
+        if (solves == 1)  // the first look's margins (probe has its velocities until now)
+          work.looked_margin[i] =
+              work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin + 2 * slack);
         probe.velocity[i] = next.velocity[i];
         probe.angular[i] = next.angular[i];
-        work.wider[i] = work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin) > looked;
+        work.wider[i] =
+            work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin) > work.looked_margin[i];
         covered = covered && !work.wider[i];
       }
-      if (covered)
-        work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
-      else
-        work.detector->find_contacts_again(work.nearby, probe, h, kContactMargin, work.wider, work.recheck);
+      if (!covered) {
+        // A pair with a wider component is looked for again to its components' margins plus kRecheckSlack
+        // each; the others keep their contacts in the old `nearby` within those sums, which is complete
+        // to the smaller of the two looked_margin sums.
+        work.detector->find_contacts_again(work.nearby, probe, h, kContactMargin + 2 * kRecheckSlack, work.wider,
+                                           work.recheck);
+        std::swap(work.nearby, work.recheck);
+        for (int i = 1; i < n; ++i) {
+          const double reach =
+              work.detector->margin(i, probe.velocity[i], probe.angular[i], h, kContactMargin + 2 * kRecheckSlack);
+          work.looked_margin[i] = work.wider[i] ? reach : std::min(work.looked_margin[i], reach);
+        }
+      }
+      work.detector->keep_within_margin(work.nearby, probe, h, kContactMargin, work.recheck);
       const auto same_pair = [](const Contact& x, const Contact& y) { return x.a == y.a && x.b == y.b; };
-      // Solved again, all of them, also when the list is the same but one the first solve left out as
-      // apart now closes: the impulses knocked one of its components towards the other. (Until
-      // 2026-12-06 only another list was: on generated-1023 after the breeze, a thread 0.08 mm from its
-      // neighbour, separating at 1 mm/s and so left out, was knocked towards it at 0.71 m/s by its other
-      // contacts' impulses and began the next step 0.62 mm deep, past the thread's radius. Now the pair's
-      // contact gets its impulse in the same step: docs/collisions.md, "A contact the knock closes".)
-      // And again, on that list, after every solve whose impulses close a contact it left out, up to
-      // kMaxSolvesPerLook solves: a knock passed along a row of pieces reaches one more pair with each
-      // solve. (Until the fourth session of 2026-12-06 the step solved twice at most:
-      // Collisions.AKnockIsPassedOnWithinTheStep, 4 balls on.)
       const bool other = work.recheck.size() != work.contacts.size() ||
                          !std::equal(work.recheck.begin(), work.recheck.end(), work.contacts.begin(), same_pair);
       if (other) std::swap(work.contacts, work.recheck);
-      bool closes = other || work.response.closes_left_out(now, work.contacts, h, next.velocity, next.angular);
-      for (int solves = 1; closes && solves < kMaxSolvesPerLook; ++solves) {
-        const ContactStepReport again =
-            work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo,
-                                  /*again=*/true);
-        add_later_solve(contact_report, again);
-        closes = again.active > 0 && work.response.closes_left_out(now, work.contacts, h, next.velocity, next.angular);
-      }
+      if (solves == kMaxSolvesPerLook ||
+          !(other || work.response.closes_left_out(now, work.contacts, h, next.velocity, next.angular)))
+        break;
+      const ContactStepReport again =
+          work.response.resolve(now, solver, work.contacts, h, next.velocity, next.angular, work.pseudo, has_pseudo,
+                                /*again=*/true);
+      add_later_solve(contact_report, again);
+      if (again.active == 0) break;  // the velocities are as they were: nothing more to look for
     }
     // The step-size rule once more, on the velocities the contact impulses made. (The contacts' list may
     // be empty again by now: a knock can send the pair apart beyond the recheck's margins.)

@@ -65,6 +65,7 @@ struct StepWorkspace {
         pseudo(model.count, Vec6::Zero()),
         probe(rest_state(model)),
         wider(model.count, 0),
+        looked_margin(model.count, 0.0),
         step_rule(model) {
     for (int i = 0; i < model.count; ++i) rotation[i] = model.rest_orientation[i].toRotationMatrix();
     for (int i = 1; i < model.count; ++i) inverse_moments[i] = model.principal_moments[i].cwiseInverse();
@@ -122,6 +123,8 @@ struct StepWorkspace {
   bool last_look_found = false;   // the last detection found contacts
   std::vector<Contact> recheck;   // contacts found again after the impulses changed the velocities
   std::vector<char> wider;        // per component: its margin after the impulses is wider than the look's
+  std::vector<double> looked_margin;  // per component: the margin (m) its pairs in `nearby` were looked for
+                                      // with (kick_and_collide)
   StepSizeRule step_rule;         // whether h is short enough for the drift and the joints (else halve)
   // Why the last (sub)step of the shortest length the subdivision allows was rejected: what a failure
   // reports. kStepRule: `rejected_body` spins too fast (`rejected_value` its turn per step, rad);
