@@ -316,18 +316,13 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   if (report.active > 0) {
     respond(contacts, P_);
     // Kept, summed over the step's resolves, for a later one's energy change (du_ is overwritten below
-    // and by the contact passes).
-    if (after_earlier) {
-      for (int i = 1; i < model_.count; ++i) {
-        velocity[i] += du_[i].head<3>();
-        angular[i] += du_[i].tail<3>();
-        earlier_change_[i] += du_[i];
-      }
-    } else {
-      for (int i = 1; i < model_.count; ++i) {
-        velocity[i] += du_[i].head<3>();
-        angular[i] += du_[i].tail<3>();
-      }
+    // and by the contact passes): added to the earlier ones', or, for the step's first, taken by swapping.
+    for (int i = 1; i < model_.count; ++i) {
+      velocity[i] += du_[i].head<3>();
+      angular[i] += du_[i].tail<3>();
+      if (after_earlier) earlier_change_[i] += du_[i];
+    }
+    if (!after_earlier) {
       std::swap(earlier_change_, du_);
       has_earlier_change_ = true;
     }
