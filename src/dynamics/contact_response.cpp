@@ -89,6 +89,37 @@ bool ContactResponse::closes_left_out(const State& pose, const std::vector<Conta
   return false;
 }
 
+void ContactResponse::start_step() {
+  pressing_.clear();
+  pushed_pairs_.clear();
+}
+
+void ContactResponse::step_taken() {
+  const auto by_pair = [](const PressedPair& x, const PressedPair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; };
+  std::sort(pressing_.begin(), pressing_.end(), by_pair);
+  std::size_t kept = 0;  // one per pair, with its fastest approach
+  for (const PressedPair& p : pressing_) {
+    if (kept > 0 && pressing_[kept - 1].a == p.a && pressing_[kept - 1].b == p.b)
+      pressing_[kept - 1].approach = std::max(pressing_[kept - 1].approach, p.approach);
+    else
+      pressing_[kept++] = p;
+  }
+  pressing_.resize(kept);
+  std::swap(pressed_before_, pressed_last_);
+  std::swap(pressed_last_, pressing_);
+  pressing_.clear();
+}
+
+double ContactResponse::pressed_recently(int a, int b) const {
+  const auto before = [](const PressedPair& p, std::pair<int, int> key) { return p.a != key.first ? p.a < key.first : p.b < key.second; };
+  double fastest = -1;
+  for (const std::vector<PressedPair>* step : {&pressed_last_, &pressed_before_}) {
+    const auto it = std::lower_bound(step->begin(), step->end(), std::make_pair(a, b), before);
+    if (it != step->end() && it->a == a && it->b == b) fastest = std::max(fastest, it->approach);
+  }
+  return fastest;
+}
+
 ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver,
                                            const std::vector<Contact>& found, double h,
                                            std::vector<Vec3>& velocity, std::vector<Vec3>& angular,
@@ -97,7 +128,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   has_pseudo = false;
   const bool after_earlier = again && has_earlier_change_;
   if (!again) has_earlier_change_ = false;
-  if (!again) pushed_pairs_.clear();
+  if (!again) start_step();
   report.contacts = static_cast<int>(found.size());
   solver_ = &solver;
 
@@ -237,7 +268,9 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       const Contact& c = contacts[k];
       const double un = u_[3 * k];
       const double e = 0.5 * (model_.restitution[c.a] + model_.restitution[c.b]);
-      const bool collides = un < -threshold && c.distance + un * h <= 0;
+      // (A pair pressed together bounces only when knocked: see start_step's declaration.)
+      const bool collides =
+          un < -threshold && c.distance + un * h <= 0 && -un > 2.0 * pressed_recently(c.a, c.b);
       rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
       if (restitution && collides && e > 0) {
         rows_[k].target_normal = -e * un;
@@ -289,6 +322,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     if (P_[3 * k] > 0) {
       ++report.active;
       pushed_pairs_.emplace_back(contacts[k].a, contacts[k].b);
+      pressing_.push_back({contacts[k].a, contacts[k].b, std::max(-u_[3 * k], 0.0)});
     }
   // The law's energy change, u^T P + P^T K P / 2, is weighed at the half-kicked velocities u; the step's
   // is weighed at its start velocities u_start = u - (what the half kick did at the contact):

@@ -132,6 +132,7 @@ ALOFT_CPU_DISPATCH bool Simulation::kick_and_collide(double h, bool guess, Conta
     // A step that will be halved as too long for its spins (checked again below, after the impulses) is
     // not worth a detection whose margins its speeds would make huge.
     if (!spins_ok) return reject_spin(h);
+    work.response.start_step();
     // Detection margins come from the velocities the drift will use: the half-step ones.
     State& probe = work.probe;
     for (int i = 0; i < n; ++i) {
