@@ -14,7 +14,8 @@
 //
 // Contacts are speculative (the detector reports pairs closer than the distance they can close in one
 // step). Per contact, with d the signed gap and u_n the normal approach velocity:
-//   * colliding within this step, faster than the bounce threshold: u_n' >= -e u_n (restitution);
+//   * colliding within this step, faster than the bounce threshold (and, for a pair stopped in one of the
+//     last two steps, faster than twice the speed it was stopped from: start_step): u_n' >= -e u_n;
 //   * otherwise: u_n' >= -max(d, 0) / h, the contact may close its gap but not pass it.
 // Penetration (d < 0, from round-off or a resting contact settling) is pushed out by a separate
 // frictionless "pseudo-velocity" that moves positions in this step's drift only and is then forgotten
@@ -36,7 +37,8 @@ namespace aloft {
 
 struct ContactTuning {
   // Normal approach speeds (m/s) below this are not bounced: a resting contact under gravity approaches
-  // at about g h per step, and bouncing it would make it chatter. Raised to 2 g h at run time.
+  // at about g h per step, and bouncing it would make it chatter. Raised to 2 g h at run time. (A pair
+  // pressed harder than gravity presses it is held by ContactResponse::start_step's rule.)
   double bounce_threshold = 0.005;
   double penetration_slop = 5e-5;  // m: overlap tolerated without correction (round-off, settling)
   double penetration_rate = 0.8;   // fraction of the overlap beyond the slop removed per step
