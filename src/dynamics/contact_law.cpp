@@ -404,16 +404,22 @@ bool polish_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& velocity, const
   return true;
 }
 
-// Block Gauss-Seidel on the law from P = 0 (P resized to 3m, m >= 1), with the Newton polish now and
-// then: true when it converged (see kRelativeChange). `sweeps` counts the sweeps; `recent_change` (per
+// Block Gauss-Seidel on the law from P = start (zero when null; P resized to 3m, m >= 1), with the Newton
+// polish now and then: true when it converged (see kRelativeChange). `sweeps` counts the sweeps; `recent_change` (per
 // contact) is set to the largest change of its impulse (max norm, N s) over the last sweeps, at least
 // kRecentSweeps of them, which tells the contacts still moving when it did not converge. `sticking` and
 // `sliding` count the contacts that ended so.
 bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std::vector<ContactLawRow>& rows,
-                  Eigen::VectorXd& P, int& sweeps, std::vector<double>& recent_change, int& sticking, int& sliding) {
+                  const Eigen::VectorXd* start, Eigen::VectorXd& P, int& sweeps, std::vector<double>& recent_change,
+                  int& sticking, int& sliding) {
   const int m = static_cast<int>(rows.size());
-  P.setZero(3 * m);
   Eigen::VectorXd velocity = u;  // u + K P, kept current
+  if (start) {
+    P = *start;
+    velocity.noalias() += K * P;
+  } else {
+    P.setZero(3 * m);
+  }
   std::vector<Mode> mode(m, Mode::kNone);
   std::vector<Eigen::Vector2d> slide(m, Eigen::Vector2d::Zero());  // per contact: its slip's direction
   std::vector<double> change_of(m, 0.0);  // per contact: how much its impulse changed in the last sweep
@@ -481,13 +487,14 @@ bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std:
 }  // namespace
 
 ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
-                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P) {
+                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P,
+                                   const Eigen::VectorXd* start) {
   const int m = static_cast<int>(rows.size());
   ContactLawResult result;
   P.setZero(3 * m);
   if (m == 0) return result;
   std::vector<double> recent_change;
-  bool converged = gauss_seidel(K, u, rows, P, result.iterations, recent_change, result.sticking, result.sliding);
+  bool converged = gauss_seidel(K, u, rows, start, P, result.iterations, recent_change, result.sticking, result.sliding);
   if (!converged) {
     // The contacts that kept changing (a cluster trading sticking for sliding, see kUnsettledFraction)
     // lose their friction for this solve, and the law is solved again: the others keep theirs.
@@ -504,7 +511,17 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
     }
     if (unsettled > 0 && unsettled < with_friction) {
       int sweeps = 0;
-      converged = gauss_seidel(K, u, calmer, P, sweeps, recent_change, result.sticking, result.sliding);
+      // From the same start, less the friction of the contacts that lose it (on the same inputs, 1023
+      // swinging: as many solves ended without any friction as from no start, 20 against 21; restarted
+      // from zero instead, 122 against 84).
+      Eigen::VectorXd calmer_start;
+      if (start) {
+        calmer_start = *start;
+        for (int k = 0; k < m; ++k)
+          if (calmer[k].friction == 0) calmer_start.segment<2>(3 * k + 1).setZero();
+      }
+      converged = gauss_seidel(K, u, calmer, start ? &calmer_start : nullptr, P, sweeps, recent_change,
+                               result.sticking, result.sliding);
       result.iterations += sweeps;
       if (converged) result.frictionless_contacts = unsettled;
     }

@@ -41,9 +41,13 @@ struct ContactLawResult {
   int frictionless_contacts = 0;
 };
 
-// Solves for P (resized to 3m). K must be 3m x 3m, u 3m.
+// Solves for P (resized to 3m). K must be 3m x 3m, u 3m. `start` (3m, or null for zero; not P itself)
+// is where Gauss-Seidel starts: a guess of P, such as the impulses the same contacts took in the last
+// step, each inside its cone. The law P meets does not depend on it, only the sweeps it takes and, where
+// the law has more than one solution (contacts whose rows depend on each other), which one it ends at.
 ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
-                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P);
+                                   const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P,
+                                   const Eigen::VectorXd* start = nullptr);
 
 // Normal-only variant (frictionless), used for the position correction: K_nn is m x m.
 void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,

@@ -92,6 +92,8 @@ bool ContactResponse::closes_left_out(const State& pose, const std::vector<Conta
 void ContactResponse::start_step() {
   pressing_.clear();
   pushed_pairs_.clear();
+  carrying_.clear();
+  carrying_step_ = 0;
 }
 
 void ContactResponse::step_taken() {
@@ -108,6 +110,39 @@ void ContactResponse::step_taken() {
   std::swap(pressed_before_, pressed_last_);
   std::swap(pressed_last_, pressing_);
   pressing_.clear();
+  std::swap(carried_, carrying_);
+  carried_step_ = carrying_step_;
+  carrying_.clear();
+  carrying_step_ = 0;
+}
+
+bool ContactResponse::start_from_carried(const std::vector<Contact>& contacts, double h) {
+  const int m = static_cast<int>(contacts.size());
+  if (carried_.empty() || !(carried_step_ > 0)) return false;
+  start_.setZero(3 * m);
+  bool any = false;
+  std::size_t j = 0;  // the first carried impulse not of a pair before contact k's (both sorted by (a, b))
+  for (int k = 0; k < m; ++k) {
+    const Contact& c = contacts[k];
+    while (j < carried_.size() && (carried_[j].a < c.a || (carried_[j].a == c.a && carried_[j].b < c.b))) ++j;
+    const CarriedImpulse* nearest = nullptr;
+    double nearest_distance = kCarriedReach;
+    for (std::size_t i = j; i < carried_.size() && carried_[i].a == c.a && carried_[i].b == c.b; ++i) {
+      const double distance = (carried_[i].point - c.point).norm();
+      if (distance <= nearest_distance) {
+        nearest = &carried_[i];
+        nearest_distance = distance;
+      }
+    }
+    if (!nearest) continue;
+    Vec3 impulse = basis_[k].transpose() * nearest->impulse * (h / carried_step_);
+    if (!(impulse.x() > 0)) continue;  // the normal turned: no guess
+    const double friction = impulse.tail<2>().norm(), most = rows_[k].friction * impulse.x();
+    if (friction > most) impulse.tail<2>() *= most / friction;  // into this contact's cone
+    start_.segment<3>(3 * k) = impulse;
+    any = true;
+  }
+  return any;
 }
 
 double ContactResponse::pressed_recently(int a, int b) const {
@@ -279,7 +314,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     }
   };
   set_targets(true);
-  ContactLawResult law = solve_contact_law(K_, u_, rows_, P_);
+  const bool warm = !again && start_from_carried(contacts, h);
+  ContactLawResult law = solve_contact_law(K_, u_, rows_, P_, warm ? &start_ : nullptr);
   int sweeps = law.iterations;
   // Energy may only leave: allow round-off relative to the energies the impulses exchange.
   const auto gained = [&](const ContactLawResult& r) {
@@ -318,8 +354,10 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   report.iterations = sweeps;
   report.sticking = law.sticking;
   report.sliding = law.sliding;
+  if (!again) carrying_step_ = h;
   for (int k = 0; k < m; ++k)
     if (P_[3 * k] > 0) {
+      if (!again) carrying_.push_back({contacts[k].a, contacts[k].b, contacts[k].point, basis_[k] * P_.segment<3>(3 * k)});
       ++report.active;
       pushed_pairs_.emplace_back(contacts[k].a, contacts[k].b);
       pressing_.push_back({contacts[k].a, contacts[k].b, std::max(-u_[3 * k], 0.0)});

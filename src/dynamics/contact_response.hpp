@@ -149,6 +149,12 @@ class ContactResponse {
   // speed it was last stopped from (faster than two steps of its pressing build: another piece knocked
   // it). start_step() begins a step's attempt (forgetting what an attempt that was not taken pressed);
   // step_taken() says that the attempt since is taken, so its pairs become the last step's.
+  //
+  // The law of a step's first resolve starts from the impulses its contacts took in the first resolve of
+  // the last step taken (each contact of a pair from the one of the same pair nearest to it, within
+  // kCarriedReach), scaled by the ratio of the step lengths: a pair pressed together is stopped by about
+  // the same impulse every step. (Until pairs pressed together stopped chattering, the impulses did not
+  // carry over: docs/performance.md, "2026-12-06, fifth session".)
   void start_step();
   void step_taken();
 
@@ -217,6 +223,25 @@ class ContactResponse {
   std::vector<PressedPair> pressing_;        // by this step's resolves so far (unsorted, repeats)
   std::vector<PressedPair> pressed_last_;    // by the last step taken: sorted by (a, b), one per pair
   std::vector<PressedPair> pressed_before_;  // by the step taken before it, the same way
+
+  // m: the farthest a contact's point may be from the last step's contact of the same pair whose impulse
+  // it starts from. A contact held from step to step moves by its pieces' relative motion in a step
+  // (well under a millimetre at the speeds the step-size rule lets through a contact); another contact of
+  // the same pair is usually farther.
+  static constexpr double kCarriedReach = 1e-3;
+  // A contact's impulse in a step's first resolve, for the next step's law to start from.
+  struct CarriedImpulse {
+    int a = 0, b = 0;
+    Vec3 point = Vec3::Zero();    // world, m: the contact's point at the step's start pose
+    Vec3 impulse = Vec3::Zero();  // world, N s: on a, from b
+  };
+  // Fills start_ for the contacts of the step's first resolve from carried_ (sorted by (a, b), as the
+  // contacts are); false when none has a carried impulse.
+  bool start_from_carried(const std::vector<Contact>& contacts, double h);
+  std::vector<CarriedImpulse> carrying_;  // this step's first resolve's, sorted by (a, b)
+  std::vector<CarriedImpulse> carried_;   // the last step taken's
+  double carrying_step_ = 0, carried_step_ = 0;  // s: their step lengths (0 while there are none)
+  Eigen::VectorXd start_;                         // where the step's first law solve starts
 };
 
 }  // namespace aloft
