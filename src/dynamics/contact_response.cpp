@@ -26,6 +26,11 @@ Vec3 point_velocity(int body, const Vec3& arm, const std::vector<Vec3>& velocity
   return body == 0 ? Vec3::Zero() : Vec3(velocity[body] + angular[body].cross(arm));
 }
 
+// Whether the pair of components (a, b) comes before (c, d) in the order contacts are listed in (by the
+// first component, then the second): the detector's order, which every list of contacts and pairs here
+// keeps.
+bool pair_before(int a, int b, int c, int d) { return a != c ? a < c : b < d; }
+
 // Relative velocity of contact c's point on a with respect to b, world.
 Vec3 relative_velocity(const Contact& c, const Vec3& arm_a, const Vec3& arm_b, const std::vector<Vec3>& velocity,
                        const std::vector<Vec3>& angular) {
@@ -97,7 +102,7 @@ void ContactResponse::start_step() {
 }
 
 void ContactResponse::step_taken() {
-  const auto by_pair = [](const PressedPair& x, const PressedPair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; };
+  const auto by_pair = [](const PressedPair& x, const PressedPair& y) { return pair_before(x.a, x.b, y.a, y.b); };
   std::sort(pressing_.begin(), pressing_.end(), by_pair);
   std::size_t kept = 0;  // one per pair, with its fastest approach
   for (const PressedPair& p : pressing_) {
@@ -124,7 +129,7 @@ bool ContactResponse::start_from_carried(const std::vector<Contact>& contacts, d
   std::size_t j = 0;  // the first carried impulse not of a pair before contact k's (both sorted by (a, b))
   for (int k = 0; k < m; ++k) {
     const Contact& c = contacts[k];
-    while (j < carried_.size() && (carried_[j].a < c.a || (carried_[j].a == c.a && carried_[j].b < c.b))) ++j;
+    while (j < carried_.size() && pair_before(carried_[j].a, carried_[j].b, c.a, c.b)) ++j;
     const CarriedImpulse* nearest = nullptr;
     double nearest_distance = kCarriedReach;
     for (std::size_t i = j; i < carried_.size() && carried_[i].a == c.a && carried_[i].b == c.b; ++i) {
@@ -146,7 +151,7 @@ bool ContactResponse::start_from_carried(const std::vector<Contact>& contacts, d
 }
 
 double ContactResponse::pressed_recently(int a, int b) const {
-  const auto before = [](const PressedPair& p, std::pair<int, int> key) { return p.a != key.first ? p.a < key.first : p.b < key.second; };
+  const auto before = [](const PressedPair& p, std::pair<int, int> key) { return pair_before(p.a, p.b, key.first, key.second); };
   double fastest = -1;
   for (const std::vector<PressedPair>* step : {&pressed_last_, &pressed_before_}) {
     const auto it = std::lower_bound(step->begin(), step->end(), std::make_pair(a, b), before);
@@ -191,7 +196,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     std::vector<Contact> soonest;
     for (int k = 0; k < kMaxContacts; ++k) soonest.push_back(contacts[order[k].second]);
     std::sort(soonest.begin(), soonest.end(), [](const Contact& x, const Contact& y) {
-      return x.a != y.a ? x.a < y.a : x.b < y.b;
+      return pair_before(x.a, x.b, y.a, y.b);
     });
     report.dropped = static_cast<int>(contacts.size()) - kMaxContacts;
     contacts = std::move(soonest);
@@ -233,7 +238,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
     std::size_t j = 0;
     for (int k = 0; k < m; ++k) {
       const Contact& c = contacts[k];
-      const auto before = [&](const Contact& q) { return q.a < c.a || (q.a == c.a && q.b < c.b); };
+      const auto before = [&](const Contact& q) { return pair_before(q.a, q.b, c.a, c.b); };
       while (j < last_contacts_.size() && before(last_contacts_[j])) ++j;
       for (std::size_t i = j; i < last_contacts_.size() && last_contacts_[i].a == c.a && last_contacts_[i].b == c.b; ++i) {
         const Contact& q = last_contacts_[i];
