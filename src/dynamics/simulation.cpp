@@ -290,7 +290,7 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
   next.time = now.time + h;
   std::swap(state_, next);
   work.factored = true;
-  if (collisions_) work.response.step_taken();  // what its contacts pressed, for the next steps' bounces
+  if (collisions_) work.response.step_taken();  // what its contacts pressed, and their impulses, for the next steps
   // (A look after the impulses may find no contacts left, `contacts` then 0, after the first look's were
   // solved: `solves` still counts that step.)
   if (contact_report.contacts > 0 || contact_report.solves > 0) {
