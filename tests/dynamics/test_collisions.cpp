@@ -311,7 +311,10 @@ TEST(Collisions, PiecesPressedHardTogetherRestWithoutBouncing) {
     s.angular[1] = arm.cross(0.5 * towards) / arm.squaredNorm();
     s.velocity[1] = s.angular[1].cross(s.position[1] - pivot);
     ASSERT_TRUE(sim.step());
-    const auto speed_of = [&](int i) { return Vec3(sim.state().velocity[i] + sim.state().angular[i].cross(centre(sim.state(), i) - sim.state().position[i])); };
+    const auto speed_of = [&](int i) {  // the ball's centre's velocity, m/s
+      const State& now = sim.state();
+      return Vec3(now.velocity[i] + now.angular[i].cross(centre(now, i) - now.position[i]));
+    };
     const double parting = (speed_of(2) - speed_of(1)).dot(towards);
     std::printf("  knocked at 0.5 m/s: parting at %.3g m/s\n", parting);
     // The pressing (2 times g h, up to 0.2 m/s at 10 weights) takes back part of the parting in the step.
