@@ -8,6 +8,9 @@
 //                        collisions off and on the same motion is timed: BM_Step and BM_StepCollisions
 //                        step on for as long as --benchmark_min_time asks, and the swing changes along
 //                        the way (docs/performance.md, "The benchmark's span matters")
+//   BM_StepSpanSeeds/<mobile>/off, .../on/seed:S  BM_StepSpan of the generated mobiles of 127 to 8191
+//                        components from other swinging states (seeds 1, 2, 3; BM_StepSpan's is 7): the
+//                        collisions' cost differs by half between trajectories
 //   BM_Factor/<mobile>   TreeSolver::factor() at a swinging pose
 //   BM_Solve/<mobile>    TreeSolver::solve() with the factorization of that pose
 //
@@ -21,6 +24,7 @@
 #include <benchmark/benchmark.h>
 #include <time.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -39,6 +43,10 @@ using aloft::Model;
 
 const std::vector<std::string> kPresets = {"steel-fish", "southern-cross"};
 const std::vector<int> kGenerated = {15, 127, 1023, 8191, 65535};
+// The swinging state's seed for every step benchmark, and the others the generated mobiles' spans are
+// also timed from (BM_StepSpanSeeds/<mobile>/<on|off>/seed:S, 127 to 8191 components).
+constexpr std::uint64_t kSeed = 7;
+const std::vector<std::uint64_t> kMoreSeeds = {1, 2, 3};
 
 // Models are built on first use (generating and compiling 65535 components takes a while) and kept.
 // A preset that is missing or does not load leaves an error message instead.
@@ -94,11 +102,12 @@ const Model* model_or_skip(benchmark::State& state, const std::string& key) {
   return entry.model.get();
 }
 
-void BM_Step(benchmark::State& state, const std::string& key, bool collisions) {
+// Steps the mobile from the swinging state drawn with `seed` (bench_models.hpp: swinging_state).
+void BM_Step(benchmark::State& state, const std::string& key, bool collisions, std::uint64_t seed) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
   const Model& model = *found;
-  aloft::Simulation sim(model, aloft::bench::swinging_state(model));
+  aloft::Simulation sim(model, aloft::bench::swinging_state(model, 0.5, seed));
   sim.set_collisions(collisions);
   const double start = cpu_seconds();
   for (auto _ : state) {
@@ -198,17 +207,33 @@ void register_all() {
   std::vector<std::string> keys = kPresets;
   for (int n : kGenerated) keys.push_back("generated-" + std::to_string(n));
   for (const std::string& key : keys)
-    benchmark::RegisterBenchmark(("BM_Step/" + key).c_str(), BM_Step, key, false)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_Step/" + key).c_str(), BM_Step, key, false, kSeed)
+        ->Unit(benchmark::kMicrosecond);
   for (const std::string& key : keys)
-    benchmark::RegisterBenchmark(("BM_StepCollisions/" + key).c_str(), BM_Step, key, true)
+    benchmark::RegisterBenchmark(("BM_StepCollisions/" + key).c_str(), BM_Step, key, true, kSeed)
         ->Unit(benchmark::kMicrosecond);
   for (const std::string& key : keys) {
     const int components = key.rfind("generated-", 0) == 0 ? std::stoi(key.substr(10)) : 10;
     for (const bool collisions : {false, true})
       benchmark::RegisterBenchmark(("BM_StepSpan/" + key + (collisions ? "/on" : "/off")).c_str(), BM_Step, key,
-                                   collisions)
+                                   collisions, kSeed)
           ->Iterations(span_steps(components))
           ->Unit(benchmark::kMicrosecond);
+  }
+  // The generated mobiles' spans from more swinging states: a tangle's cost differs by half between
+  // trajectories (docs/performance.md, "2026-12-06, fifth session"), and a change to the collisions
+  // changes the trajectory, so one start cannot show a change of a few per cent.
+  for (const std::string& key : keys) {
+    if (key.rfind("generated-", 0) != 0) continue;
+    const int components = std::stoi(key.substr(10));
+    if (components < 127 || components > 8191) continue;
+    for (const std::uint64_t seed : kMoreSeeds)
+      for (const bool collisions : {false, true})
+        benchmark::RegisterBenchmark(
+            ("BM_StepSpanSeeds/" + key + (collisions ? "/on" : "/off") + "/seed:" + std::to_string(seed)).c_str(),
+            BM_Step, key, collisions, seed)
+            ->Iterations(span_steps(components))
+            ->Unit(benchmark::kMicrosecond);
   }
   for (const std::string& key : keys)
     benchmark::RegisterBenchmark(("BM_Factor/" + key).c_str(), BM_Factor, key)->Unit(benchmark::kMicrosecond);
