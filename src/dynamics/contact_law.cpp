@@ -494,7 +494,8 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   P.setZero(3 * m);
   if (m == 0) return result;
   std::vector<double> recent_change;
-  bool converged = gauss_seidel(K, u, rows, start, P, result.iterations, recent_change, result.sticking, result.sliding);
+  bool converged =
+      gauss_seidel(K, u, rows, start, P, result.iterations, recent_change, result.sticking, result.sliding);
   if (!converged) {
     // The contacts that kept changing (a cluster trading sticking for sliding, see kUnsettledFraction)
     // lose their friction for this solve, and the law is solved again: the others keep theirs.

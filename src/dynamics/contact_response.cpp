@@ -151,7 +151,9 @@ bool ContactResponse::start_from_carried(const std::vector<Contact>& contacts, d
 }
 
 double ContactResponse::pressed_recently(int a, int b) const {
-  const auto before = [](const PressedPair& p, std::pair<int, int> key) { return pair_before(p.a, p.b, key.first, key.second); };
+  const auto before = [](const PressedPair& p, std::pair<int, int> key) {
+    return pair_before(p.a, p.b, key.first, key.second);
+  };
   double fastest = -1;
   for (const std::vector<PressedPair>* step : {&pressed_last_, &pressed_before_}) {
     const auto it = std::lower_bound(step->begin(), step->end(), std::make_pair(a, b), before);
@@ -362,7 +364,8 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   if (!again) carrying_step_ = h;
   for (int k = 0; k < m; ++k)
     if (P_[3 * k] > 0) {
-      if (!again) carrying_.push_back({contacts[k].a, contacts[k].b, contacts[k].point, basis_[k] * P_.segment<3>(3 * k)});
+      if (!again)
+        carrying_.push_back({contacts[k].a, contacts[k].b, contacts[k].point, basis_[k] * P_.segment<3>(3 * k)});
       ++report.active;
       pushed_pairs_.emplace_back(contacts[k].a, contacts[k].b);
       pressing_.push_back({contacts[k].a, contacts[k].b, std::max(-u_[3 * k], 0.0)});

@@ -269,7 +269,7 @@ TEST(Collisions, RestingContactNeitherJittersNorSinks) {
 
 // The leaning balls pressed together by a steady force of `times` their weight each (as a strong wind
 // presses a light plate on a wire, or a tangle's joints press one light piece on another): between two
-// steps they approach at 2 times g h, faster than the bounce threshold (2 g h). Until 2026-12-06 each
+// steps they approach at 2 `times` g h, faster than the bounce threshold (2 g h). Until 2026-12-06 each
 // step that stopped them bounced them (e = 0.3), and the force brought them back a step or two later:
 // over a second the gap went from 0 to 0.013, 0.056 and 0.19 mm at 1.5, 3 and 10 weights, and at 3 and
 // 10 they were stopped in only 602 of the 1000 steps. Now they rest. Knocked hard, the pair still bounces.

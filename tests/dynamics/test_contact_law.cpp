@@ -349,10 +349,10 @@ TEST(ContactLaw, AStartNearTheImpulsesSavesSweepsAndMeetsTheSameLaw) {
   // The landings above, solved from a start (ContactResponse starts a step's law from the impulses its
   // contacts took in the last step): from the impulses themselves, from them 10 % off (a pair pressed
   // together from step to step: a throwaway count on generated-1023 swinging put the median start 13 %
-  // from the impulses the law then found), and from
-  // a start far from them (10 times the impulses). Every result meets the law; the near starts take
-  // fewer sweeps, except without friction, where the four corners' dependent rows converge only through
-  // the exact solve after 8 sweeps (contact_law.cpp, kPolishFirstSweep) whatever the start.
+  // from the impulses the law then found), and from a start far from them (10 times the impulses).
+  // Every result meets the law; the near starts take fewer sweeps, except without friction, where the
+  // four corners' dependent rows converge only through the exact solve after 8 sweeps (contact_law.cpp,
+  // kPolishFirstSweep) whatever the start.
   int all_cold_sweeps = 0, all_near_sweeps = 0;
   for (const double mu : {0.0, 0.3, 1.0}) {
     std::srand(31);
