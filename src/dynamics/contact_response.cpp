@@ -96,7 +96,6 @@ bool ContactResponse::closes_left_out(const State& pose, const std::vector<Conta
 
 void ContactResponse::start_step() {
   pressing_.clear();
-  pushed_pairs_.clear();
   carrying_.clear();
   carrying_step_ = 0;
 }
@@ -367,7 +366,6 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       if (!again)
         carrying_.push_back({contacts[k].a, contacts[k].b, contacts[k].point, basis_[k] * P_.segment<3>(3 * k)});
       ++report.active;
-      pushed_pairs_.emplace_back(contacts[k].a, contacts[k].b);
       pressing_.push_back({contacts[k].a, contacts[k].b, std::max(-u_[3 * k], 0.0)});
     }
   // The law's energy change, u^T P + P^T K P / 2, is weighed at the half-kicked velocities u; the step's

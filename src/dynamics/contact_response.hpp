@@ -133,10 +133,16 @@ class ContactResponse {
   static constexpr int kMaxContacts = 128;
   // The contacts the last resolve() solved, in the order of the matrices below.
   const std::vector<Contact>& kept() const { return kept_; }
-  // The pairs of components (a < b) given a normal impulse by the step's resolves (the first, and the
-  // later ones, `again`; a pair may appear more than once). The contact passes' corrections are not
-  // included.
-  const std::vector<std::pair<int, int>>& pushed_pairs() const { return pushed_pairs_; }
+  // A pair of components (a < b) given a normal impulse, and the fastest it approached (m/s, >= 0) where
+  // it was stopped.
+  struct PressedPair {
+    int a = 0, b = 0;
+    double approach = 0;
+  };
+  // The pairs given a normal impulse by the resolves of the last step taken (the first, and the later
+  // ones, `again`; the contact passes' corrections are not included), one per pair, sorted by (a, b).
+  // Set by step_taken().
+  const std::vector<PressedPair>& pressed_last_step() const { return pressed_last_; }
 
   // A contact pressed by a steady force does not bounce. Between two steps that stop it, a pair pressed
   // together approaches by a h (a its relative acceleration without the contact); where a exceeds the 2 g
@@ -210,13 +216,6 @@ class ContactResponse {
   // weighs a later one's energy change (resolve(), `again`); valid when has_earlier_change_.
   std::vector<Vec6> earlier_change_;
   bool has_earlier_change_ = false;
-  std::vector<std::pair<int, int>> pushed_pairs_;
-  // A pair of components (a < b) given a normal impulse, and the fastest it approached (m/s, >= 0) where
-  // it was stopped.
-  struct PressedPair {
-    int a = 0, b = 0;
-    double approach = 0;
-  };
   // The fastest approach (m/s) the pair (a, b) was stopped from in the last two steps taken, or -1 when
   // it was not stopped in them.
   double pressed_recently(int a, int b) const;

@@ -308,10 +308,9 @@ ALOFT_CPU_DISPATCH bool Simulation::rattle(double h) {
     stats.energy_removed -= contact_report.energy_change;
     stats.deepest = std::max(stats.deepest, contact_report.deepest);
     stats.deepest_relative = std::max(stats.deepest_relative, contact_report.deepest_relative);
-    if (contact_report.active > 0) {
-      const std::vector<std::pair<int, int>>& pushed = work.response.pushed_pairs();
-      work.pushed_pairs.insert(work.pushed_pairs.end(), pushed.begin(), pushed.end());
-    }
+    if (contact_report.active > 0)
+      for (const ContactResponse::PressedPair& pushed : work.response.pressed_last_step())
+        work.pushed_pairs.emplace_back(pushed.a, pushed.b);
   }
   return true;
 }
