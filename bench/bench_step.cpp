@@ -223,10 +223,9 @@ void register_all() {
   // The generated mobiles' spans from more swinging states: a tangle's cost differs by half between
   // trajectories (docs/performance.md, "2026-12-06, fifth session"), and a change to the collisions
   // changes the trajectory, so one start cannot show a change of a few per cent.
-  for (const std::string& key : keys) {
-    if (key.rfind("generated-", 0) != 0) continue;
-    const int components = std::stoi(key.substr(10));
+  for (const int components : kGenerated) {
     if (components < 127 || components > 8191) continue;
+    const std::string key = "generated-" + std::to_string(components);
     for (const std::uint64_t seed : kMoreSeeds)
       for (const bool collisions : {false, true})
         benchmark::RegisterBenchmark(

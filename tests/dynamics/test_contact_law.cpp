@@ -355,7 +355,7 @@ TEST(ContactLaw, AStartNearTheImpulsesSavesSweepsAndMeetsTheSameLaw) {
   // kPolishFirstSweep) whatever the start.
   int all_cold_sweeps = 0, all_near_sweeps = 0;
   for (const double mu : {0.0, 0.3, 1.0}) {
-    std::srand(31);
+    std::srand(31);  // Quat::UnitRandom (random_body) draws from std::rand
     std::mt19937 rng(31);
     std::uniform_real_distribution<double> off(-0.1, 0.1);
     int cold_sweeps = 0, near_sweeps = 0, converged = 0;
