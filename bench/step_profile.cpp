@@ -5,11 +5,15 @@
 // step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
 // the function to give callgrind's --toggle-collect.
 //
-//   aloft_step_profile [--every N] MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
+//   aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]]
+//                      MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
 //     --every N: also print, after every N steps, the same figures for those N steps alone (how a run's
 //       cost changes along it: a generated mobile with collisions tangles, and its late steps cost many
 //       times its early ones; docs/performance.md), with the energy, the fastest spin and the deepest
 //       overlap at the block's end
+//     --record-law FILE: write the contact law's solves of the timed steps to FILE
+//       (aloft/contact_law_record.hpp), to be solved again by aloft_law_replay: every N-th (default 1) of
+//       those with M contacts or more (default 1)
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
 //     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
 //       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
@@ -36,9 +40,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <fstream>
 #include <string>
 #include <utility>
 
+#include "aloft/contact_law_record.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
@@ -113,11 +119,27 @@ void print_rates(const char* indent, const Counts& before, const Counts& after, 
 int main(int argc, char** argv) {
   using namespace aloft;
   long every = 0;  // --every N: steps per block of the per-block report (0: none)
-  if (argc > 2 && std::string(argv[1]) == "--every") {
-    char* end = nullptr;
-    every = std::strtol(argv[2], &end, 10);
-    if (*argv[2] == '\0' || *end != '\0' || every <= 0) {
-      std::fprintf(stderr, "aloft_step_profile: --every takes a whole number of steps > 0, not '%s'\n", argv[2]);
+  std::string record_path;  // --record-law FILE: the contact law's solves written there
+  long record_every = 1, record_min = 1;  // --record-every N, --record-min M
+  while (argc > 2 && std::string(argv[1]).starts_with("--")) {
+    const std::string option = argv[1];
+    const auto whole = [&](long& value) {
+      char* end = nullptr;
+      value = std::strtol(argv[2], &end, 10);
+      if (*argv[2] != '\0' && *end == '\0' && value > 0) return true;
+      std::fprintf(stderr, "aloft_step_profile: %s takes a whole number > 0, not '%s'\n", option.c_str(), argv[2]);
+      return false;
+    };
+    if (option == "--every") {
+      if (!whole(every)) return 2;
+    } else if (option == "--record-every") {
+      if (!whole(record_every)) return 2;
+    } else if (option == "--record-min") {
+      if (!whole(record_min)) return 2;
+    } else if (option == "--record-law") {
+      record_path = argv[2];
+    } else {
+      std::fprintf(stderr, "aloft_step_profile: unknown option '%s'\n", option.c_str());
       return 2;
     }
     argc -= 2;
@@ -125,8 +147,9 @@ int main(int argc, char** argv) {
   }
   if (argc < 3) {
     std::fprintf(stderr,
-                 "usage: aloft_step_profile [--every N] MOBILE(.json or component count) STEPS [collisions 0|1] "
-                 "[breeze|swinging[:SEED]] [joint tolerance, m]\n");
+                 "usage: aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]] "
+                 "MOBILE(.json or component count) STEPS [collisions 0|1] [breeze|swinging[:SEED]] "
+                 "[joint tolerance, m]\n");
     return 2;
   }
   const std::string what = argv[1];
@@ -175,6 +198,20 @@ int main(int argc, char** argv) {
       sim.loads().clear();
     }
     sim.set_joint_tolerance(joint_tolerance);
+    // The timed steps' contact-law solves, every record_every-th of those with at least record_min
+    // contacts, written to record_path (the copies and the writing are timed with the steps).
+    std::ofstream record_file;
+    long solves_seen = 0, solves_recorded = 0;
+    if (!record_path.empty()) {
+      record_file.open(record_path, std::ios::binary | std::ios::trunc);
+      if (!record_file) throw std::runtime_error("cannot write " + record_path);
+      write_contact_law_header(record_file);
+      sim.record_contact_laws([&](const ContactLawRecord& record) {
+        if (record.contacts() < record_min || solves_seen++ % record_every != 0) return;
+        write_contact_law_record(record_file, record);
+        ++solves_recorded;
+      });
+    }
     const long long halvings = sim.subdivisions(), iterations = sim.joint_iterations();
     const Counts before = counts_of(sim);
     // The timed steps, in blocks of `every` when asked (each block printed as it ends; the steps and the
@@ -219,6 +256,13 @@ int main(int argc, char** argv) {
                 what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
                 (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
     print_rates("  ", before, counts_of(sim), steps);
+    if (!record_path.empty()) {
+      record_file.close();
+      if (!record_file) throw std::runtime_error("could not finish writing " + record_path);
+      std::printf("recorded %ld of the %ld contact-law solves of %ld contacts or more in %s (the time above "
+                  "includes the recording)\n",
+                  solves_recorded, solves_seen, record_min, record_path.c_str());
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aloft_step_profile: %s\n", e.what());
     return 1;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "aloft/collision.hpp"
+#include "aloft/contact_law_record.hpp"
 #include "aloft/state.hpp"
 
 namespace aloft {
@@ -167,6 +168,9 @@ class Simulation {
   // contact's distance at a step's start: this is where to see it.
   const std::vector<std::pair<int, int>>& pushed_pairs() const;
   const CollisionStatistics& collision_statistics() const { return collision_stats_; }
+  // Hands every solve of the contact law the steps make (the rejected tries' too) to `recorder`, or to
+  // none when it is empty: for measuring the law on fixed inputs (aloft/contact_law_record.hpp).
+  void record_contact_laws(ContactLawRecorder recorder);
   // The detector (for its pair pruning), or null when collisions are off.
   const CollisionDetector* collision_detector() const;
 

@@ -321,7 +321,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   };
   set_targets(true);
   const bool warm = !again && start_from_carried(contacts, h);
-  ContactLawResult law = solve_contact_law(K_, u_, rows_, P_, warm ? &start_ : nullptr);
+  ContactLawResult law = solve_law(warm ? &start_ : nullptr);
   int sweeps = law.iterations;
   // Energy may only leave: allow round-off relative to the energies the impulses exchange.
   const auto gained = [&](const ContactLawResult& r) {
@@ -330,7 +330,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
   };
   if (any_bounce && gained(law)) {
     set_targets(false);
-    law = solve_contact_law(K_, u_, rows_, P_);
+    law = solve_law(nullptr);
     sweeps += law.iterations;
     report.restitution_dropped = true;
   }
@@ -446,7 +446,7 @@ bool ContactResponse::solve_correction(double h, const std::vector<Vec3>& veloci
     needed = needed || u_[3 * k] < rows_[k].target_normal - tolerance;
   }
   if (!needed) return false;
-  solve_contact_law(K_, u_, rows_, P_);
+  solve_law(nullptr);
   return true;
 }
 
@@ -456,6 +456,26 @@ void ContactResponse::apply_correction(std::vector<Vec3>& velocity, std::vector<
     velocity[i] += du_[i].head<3>();
     angular[i] += du_[i].tail<3>();
   }
+}
+
+ContactLawResult ContactResponse::solve_law(const Eigen::VectorXd* start) {
+  const ContactLawResult result = solve_contact_law(K_, u_, rows_, P_, start);
+  if (recorder_) {
+    const int m = static_cast<int>(rows_.size());
+    record_.K = K_;
+    record_.u = u_;
+    record_.target_normal.resize(m);
+    record_.friction.resize(m);
+    for (int k = 0; k < m; ++k) {
+      record_.target_normal[k] = rows_[k].target_normal;
+      record_.friction[k] = rows_[k].friction;
+    }
+    if (start) record_.start = *start;
+    else record_.start.resize(0);
+    record_.impulses = P_;
+    recorder_(record_);
+  }
+  return result;
 }
 
 }  // namespace aloft

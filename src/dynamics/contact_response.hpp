@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "aloft/collision.hpp"
+#include "aloft/contact_law_record.hpp"
 #include "dynamics/contact_law.hpp"
 #include "dynamics/tree_solver.hpp"
 
@@ -166,6 +167,10 @@ class ContactResponse {
 
   ContactTuning tuning;
 
+  // Hands every solve of the contact law (resolve's and solve_correction's) to `recorder` as it is made,
+  // or to none when it is empty (aloft/contact_law_record.hpp). Recording copies the solve's matrices.
+  void record_laws(ContactLawRecorder recorder) { recorder_ = std::move(recorder); }
+
   // The collision matrix and pre-impulse contact velocities of the last resolve (contact bases), for
   // tests.
   const Eigen::MatrixXd& collision_matrix() const { return K_; }
@@ -183,6 +188,8 @@ class ContactResponse {
   // The impulses `P` as wrenches on the contacts' bodies (wrench_, listed in touched_), and back to zero.
   void gather_wrenches(const std::vector<Contact>& contacts, const Eigen::VectorXd& P);
   void clear_wrenches(const std::vector<Contact>& contacts);
+  // solve_contact_law on K_, u_ and rows_ into P_ from `start` (null: from zero), recorded when asked.
+  ContactLawResult solve_law(const Eigen::VectorXd* start);
 
   const Model& model_;
   TreeSolver* solver_ = nullptr;  // the one passed to resolve(), factored at its pose
@@ -241,6 +248,8 @@ class ContactResponse {
   std::vector<CarriedImpulse> carried_;   // the last step taken's
   double carrying_step_ = 0, carried_step_ = 0;  // s: their step lengths (0 while there are none)
   Eigen::VectorXd start_;                         // where the step's first law solve starts
+  ContactLawRecorder recorder_;  // empty: the solves are not recorded
+  ContactLawRecord record_;      // the one handed to recorder_ (its storage reused)
 };
 
 }  // namespace aloft

@@ -80,6 +80,8 @@ void Simulation::set_collisions(bool enabled) {
   if (!enabled) work_->contacts.clear();
 }
 
+void Simulation::record_contact_laws(ContactLawRecorder recorder) { work_->response.record_laws(std::move(recorder)); }
+
 void Simulation::set_sparse_corrections(bool on) { work_->most_open = on ? work_->sparse_open : 0; }
 
 const std::vector<Contact>& Simulation::contacts() const { return work_->contacts; }
