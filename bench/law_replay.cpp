@@ -10,7 +10,7 @@
 // changing; dropped at every contact), the solves, their mean size and sweeps and their share of the
 // time; the law's work (sweeps times m^2, what a sweep's cost grows with); the contacts left without
 // friction; and whether each solve gave the impulses the recording holds, bit for bit (the same law on
-// the same machine does), or how far it is from them.
+// the same machine does), or how far it is from them (relative to the largest impulse of either).
 
 #include <time.h>
 
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     if (P == r.impulses) {
       ++identical;
     } else {
-      const double scale = std::max(r.impulses.cwiseAbs().maxCoeff(), 1e-300);
+      const double scale = std::max({r.impulses.cwiseAbs().maxCoeff(), P.cwiseAbs().maxCoeff(), 1e-300});
       const double difference = (P - r.impulses).cwiseAbs().maxCoeff() / scale;
       if (!(difference <= largest_difference)) {
         largest_difference = difference;
@@ -128,8 +128,8 @@ int main(int argc, char** argv) {
   if (identical == static_cast<long>(records.size()))
     std::printf("  impulses: every solve as recorded, bit for bit\n");
   else
-    std::printf("  impulses: %ld of %zu solves as recorded bit for bit; the largest difference %.3g of the solve's "
-                "largest impulse (solve %ld)\n",
+    std::printf("  impulses: %ld of %zu solves as recorded bit for bit; the largest difference %.3g of the "
+                "largest impulse of either (solve %ld)\n",
                 identical, records.size(), largest_difference, largest_at);
   return 0;
 }

@@ -332,6 +332,29 @@ constexpr double kPolishRank = 1e-12;  // pivots below this fraction of the larg
 // against 596), and the largest normal velocity short of its target fell from 1.2e-6 to 1.2e-8 m/s.
 // (Limits of 1e3 and 10: 148,609 and 151,631 sweeps, 26 and 14 solves without friction.)
 constexpr double kPolishGrowth = 100;
+// After the kMaxPolishes polishes of the schedule above, a solve whose contacts have all kept their modes
+// (none, sticking, sliding, normal only) for kSettledSweeps sweeps, and that many since the last polish,
+// is polished again, up to kMaxSettledPolishes more times. With the modes settled the law is smooth
+// where Gauss-Seidel is, and its convergence is linear, at times very slow: one solve recorded at
+// generated-8191 (aloft_law_replay, docs/performance.md, "2026-12-06, seventh session") went from 1e-6 to
+// 1e-13 at 0.965 per sweep, 300 sweeps after the schedule's last polish, where Newton's method on the
+// slowest contacts, in those modes, ends it. Measured on 798 solves recorded from `aloft_step_profile
+// 8191 2000 1 swinging:1` (every 20th of 20 contacts or more) and 1270 from `1023 5000 1 swinging:1`
+// (every 10th of 5 or more), with kCyclingModeChanges below: the law's work (sweeps x m^2) -39 % and
+// -16 %, the contacts left without friction 8046 -> 3386 and 1388 -> 686.
+constexpr int kSettledSweeps = 4;
+constexpr int kMaxSettledPolishes = 6;
+
+// A contact whose mode has changed kCyclingModeChanges times after the first two sweeps is cycling (one
+// traced at generated-8191: two contacts trading sticking for sliding with a period of 4 sweeps, from the
+// 9th sweep on, while the rest settled): it loses its friction for the rest of the solve and the sweeps
+// go on. Until the seventh session of 2026-12-06 such a solve ran on until the forecast gave it up (31
+// sweeps at least) and was solved again with no friction at every contact that had changed by
+// kUnsettledFraction of the largest change (21 contacts in the one traced, against the 2 that cycled).
+// On the recordings above, alone (without the settled polishes), 1.10 times the work and 7106 contacts
+// left without friction against 8046; of the 595 solves at 8191 that converged without it, 12 had a
+// contact change mode 4 times or more.
+constexpr int kCyclingModeChanges = 4;
 
 bool polish_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& velocity, const std::vector<ContactLawRow>& rows,
                 const std::vector<Mode>& mode, const std::vector<double>& change, Eigen::VectorXd& P) {
@@ -405,11 +428,12 @@ bool polish_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& velocity, const
 }
 
 // Block Gauss-Seidel on the law from P = start (zero when null; P resized to 3m, m >= 1), with the Newton
-// polish now and then: true when it converged (see kRelativeChange). `sweeps` counts the sweeps; `recent_change` (per
-// contact) is set to the largest change of its impulse (max norm, N s) over the last sweeps, at least
+// polish now and then: true when it converged (see kRelativeChange). A contact found cycling
+// (kCyclingModeChanges) has its friction in `rows` set to 0. `sweeps` counts the sweeps; `recent_change`
+// (per contact) is set to the largest change of its impulse (max norm, N s) over the last sweeps, at least
 // kRecentSweeps of them, which tells the contacts still moving when it did not converge. `sticking` and
 // `sliding` count the contacts that ended so.
-bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std::vector<ContactLawRow>& rows,
+bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, std::vector<ContactLawRow>& rows,
                   const Eigen::VectorXd* start, Eigen::VectorXd& P, int& sweeps, std::vector<double>& recent_change,
                   int& sticking, int& sliding) {
   const int m = static_cast<int>(rows.size());
@@ -426,7 +450,9 @@ bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std:
   // Per contact, the largest change over the sweeps since the window was last restarted, and over the
   // window before (the two together cover kRecentSweeps to 2 kRecentSweeps sweeps).
   std::vector<double> window_change(m, 0.0), last_window_change(m, 0.0);
-  int polishes = 0;
+  int polishes = 0, settled_polishes = 0;
+  int last_mode_change = 0, last_polish = 0;  // the sweeps they were made in
+  std::vector<int> mode_changes(m, 0);         // per contact, after the second sweep
   std::vector<BlockSolver> blocks(m);  // formed as the contacts need them
   double velocity_scale = u.cwiseAbs().maxCoeff();
   for (const ContactLawRow& row : rows) velocity_scale = std::max(velocity_scale, std::abs(row.target_normal));
@@ -445,7 +471,12 @@ bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std:
       const Mat3d Kkk = K.block<3, 3>(3 * k, 3 * k);
       const Vec3d old = P.segment<3>(3 * k);
       const Vec3d u_free = velocity.segment<3>(3 * k) - Kkk * old;
+      const Mode mode_before = mode[k];
       const Vec3d next = contact_impulse(Kkk, blocks[k], u_free, rows[k], mode[k], slide[k]);
+      if (mode[k] != mode_before) {
+        last_mode_change = sweep;
+        if (sweep > 2 && ++mode_changes[k] >= kCyclingModeChanges) rows[k].friction = 0;
+      }
       const Vec3d change = next - old;
       if (change.squaredNorm() > 0) {
         velocity.noalias() += K.middleCols<3>(3 * k) * change;
@@ -463,8 +494,13 @@ bool gauss_seidel(const Eigen::MatrixXd& K, const Eigen::VectorXd& u, const std:
       break;
     }
     if (forecast.hopeless(sweep, std::min(largest_change / largest_impulse, velocity_change / velocity_scale))) break;
-    if (polishes < kMaxPolishes && sweep == kPolishFirstSweep + polishes * kPolishEvery) {
-      ++polishes;
+    const bool scheduled = polishes < kMaxPolishes && sweep == kPolishFirstSweep + polishes * kPolishEvery;
+    const bool settled = polishes == kMaxPolishes && settled_polishes < kMaxSettledPolishes &&
+                         sweep - last_mode_change >= kSettledSweeps && sweep - last_polish >= kSettledSweeps;
+    if (scheduled || settled) {
+      if (scheduled) ++polishes;
+      else ++settled_polishes;
+      last_polish = sweep;
       polished = P;
       if (polish_law(K, velocity, rows, mode, change_of, polished) &&
           polished.cwiseAbs().maxCoeff() <= kPolishGrowth * largest_impulse) {
@@ -494,18 +530,25 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   P.setZero(3 * m);
   if (m == 0) return result;
   std::vector<double> recent_change;
+  std::vector<ContactLawRow> law = rows;  // with the friction of the contacts found cycling taken away
+  const auto without_friction = [&](const std::vector<ContactLawRow>& solved) {
+    int count = 0;
+    for (int k = 0; k < m; ++k) count += rows[k].friction > 0 && !(solved[k].friction > 0);
+    return count;
+  };
   bool converged =
-      gauss_seidel(K, u, rows, start, P, result.iterations, recent_change, result.sticking, result.sliding);
+      gauss_seidel(K, u, law, start, P, result.iterations, recent_change, result.sticking, result.sliding);
+  if (converged) result.frictionless_contacts = without_friction(law);
   if (!converged) {
     // The contacts that kept changing (a cluster trading sticking for sliding, see kUnsettledFraction)
     // lose their friction for this solve, and the law is solved again: the others keep theirs.
     const double largest = *std::max_element(recent_change.begin(), recent_change.end());
-    std::vector<ContactLawRow> calmer = rows;
-    int unsettled = 0, with_friction = 0;
+    std::vector<ContactLawRow> calmer = law;
+    int unsettled = without_friction(law), with_friction = 0;
     for (int k = 0; k < m; ++k) {
       if (!(rows[k].friction > 0)) continue;
       ++with_friction;
-      if (recent_change[k] >= kUnsettledFraction * largest) {
+      if (calmer[k].friction > 0 && recent_change[k] >= kUnsettledFraction * largest) {
         calmer[k].friction = 0;
         ++unsettled;
       }
@@ -524,7 +567,7 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
       converged = gauss_seidel(K, u, calmer, start ? &calmer_start : nullptr, P, sweeps, recent_change,
                                result.sticking, result.sliding);
       result.iterations += sweeps;
-      if (converged) result.frictionless_contacts = unsettled;
+      if (converged) result.frictionless_contacts = without_friction(calmer);
     }
   }
   if (!converged) {
