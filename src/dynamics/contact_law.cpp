@@ -336,12 +336,13 @@ constexpr double kPolishGrowth = 100;
 // (none, sticking, sliding, normal only) for kSettledSweeps sweeps, and that many since the last polish,
 // is polished again, up to kMaxSettledPolishes more times. With the modes settled the law is smooth
 // where Gauss-Seidel is, and its convergence is linear, at times very slow: one solve recorded at
-// generated-8191 (aloft_law_replay, docs/performance.md, "2026-12-06, seventh session") went from 1e-6 to
-// 1e-13 at 0.965 per sweep, 300 sweeps after the schedule's last polish, where Newton's method on the
-// slowest contacts, in those modes, ends it. Measured on 798 solves recorded from `aloft_step_profile
-// 8191 2000 1 swinging:1` (every 20th of 20 contacts or more) and 1270 from `1023 5000 1 swinging:1`
-// (every 10th of 5 or more), with kCyclingModeChanges below: the law's work (sweeps x m^2) -39 % and
-// -16 %, the contacts left without friction 8046 -> 3386 and 1388 -> 686.
+// generated-8191 (aloft_law_replay, docs/performance.md, "2026-12-06, seventh session"), solved with the
+// cycling rule below alone, went from 1e-6 to 1e-13 at 0.965 per sweep, 300 sweeps after the schedule's
+// last polish, where Newton's method on the slowest contacts, in those modes, ends it. Measured on 798
+// solves recorded from `aloft_step_profile 8191 2000 1 swinging:1` (every 20th of 20 contacts or more)
+// and 1270 from `1023 5000 1 swinging:1` (every 10th of 5 or more), with kCyclingModeChanges below: the
+// law's work (sweeps x m^2) -39 % and -16 %, its time -10 % and -12 % (the extra factorizations cost
+// part of what their sweeps save), the contacts left without friction 8046 -> 3386 and 1388 -> 686.
 constexpr int kSettledSweeps = 4;
 constexpr int kMaxSettledPolishes = 6;
 

@@ -14,7 +14,9 @@
 // would stick is computed; if it lies outside the cone the contact slides, and the sliding impulse is
 // solved for, one equation in the angle of its friction), so the system is solved once, not once per
 // guess. Several simultaneous contacts are iterated until their impulses stop changing, with Newton's
-// method on the slowest of them now and then (contact_law.cpp, polish_law).
+// method on the slowest of them now and then, and again once every contact's mode has settled
+// (contact_law.cpp, polish_law); a contact that keeps trading sticking for sliding loses its friction for
+// the solve.
 
 #include <Eigen/Dense>
 
@@ -36,8 +38,9 @@ struct ContactLawResult {
   // changing solved without friction: P is the frictionless normal law's solution instead (sticking and
   // sliding are then 0).
   bool friction_dropped = false;
-  // The contacts solved without friction: those that kept changing when Gauss-Seidel with friction did
-  // not converge (solved again without theirs, the others with theirs), or all m when friction_dropped.
+  // The contacts solved without friction: those found cycling between sticking and sliding in the sweeps
+  // (contact_law.cpp, kCyclingModeChanges), and those that kept changing when Gauss-Seidel with friction
+  // did not converge (solved again without theirs, the others with theirs); or all m when friction_dropped.
   int frictionless_contacts = 0;
 };
 
