@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "aloft/contact_law_record.hpp"
 #include "aloft/math.hpp"
 #include "dynamics/contact_law.hpp"
 
@@ -651,6 +652,49 @@ TEST(ContactLaw, RowOfBeadsKnockedFromOneEndMovesOnTogether) {
   // Without friction the full law's sweeps are those of the normal law; they converge too slowly for
   // its forecast (contact_law.cpp), which hands the solve to the normal law.
   expect_row_of_beads_moves_on_together("full");
+}
+
+// A solve recorded from the tangle of generated-1023 (`aloft_step_profile --record-law ... --record-every 10
+// --record-min 5 1023 5000 1 swinging:1`, its 227th record; tests/data/generated-1023-tangle-solve.law):
+// 34 contacts, mu 0.4, no start. Two rules of the law decide how it ends (contact_law.cpp): a contact that
+// changes mode 4 times loses its friction within the sweeps (kCyclingModeChanges), and a solve whose modes
+// have settled is polished again (kSettledSweeps). Measured: 37 sweeps, friction lost at 1 contact. With
+// the cycling rule alone, 143 sweeps (1 contact); with the settled polishes alone, or with neither (the law
+// before the seventh session of 2026-12-06), 52 sweeps and friction lost at 16 contacts (the sweeps did
+// not converge and the contacts that kept changing were solved again without it).
+TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
+  const std::string path = std::string(ALOFT_SOURCE_DIR) + "/tests/data/generated-1023-tangle-solve.law";
+  const std::vector<ContactLawRecord> records = read_contact_law_records(path);
+  ASSERT_EQ(records.size(), 1u);
+  const ContactLawRecord& r = records[0];
+  const int m = r.contacts();
+  ASSERT_EQ(m, 34);
+  std::vector<ContactLawRow> rows;
+  for (int k = 0; k < m; ++k) rows.push_back({r.target_normal[k], r.friction[k]});
+  Eigen::VectorXd P;
+  const ContactLawResult result = solve_contact_law(r.K, r.u, rows, P);
+  // Bounds with room over the measured 37 and 1, below the 52 and 16 (or 143) without either rule.
+  EXPECT_FALSE(result.friction_dropped);
+  EXPECT_LE(result.frictionless_contacts, 3);
+  EXPECT_LE(result.iterations, 45);
+  // The law holds at every contact: no approach beyond the target, no push while separating, the impulse
+  // inside its cone (frictionless contacts: no tangential impulse). Tolerances: 1e-9 of the velocities'
+  // scale, far above the sweeps' 1e-13 convergence and far below the mm/s that matter.
+  const Eigen::VectorXd after = r.u + r.K * P;
+  const double scale = std::max(r.u.cwiseAbs().maxCoeff(), r.target_normal.cwiseAbs().maxCoeff());
+  const double largest = P.cwiseAbs().maxCoeff();
+  int with_friction_kept = 0;
+  for (int k = 0; k < m; ++k) {
+    const double beyond = after[3 * k] - r.target_normal[k];
+    EXPECT_GE(beyond, -1e-9 * scale) << "contact " << k;
+    EXPECT_GE(P[3 * k], 0.0) << "contact " << k;
+    EXPECT_LE(std::abs(P[3 * k] * beyond), 1e-9 * scale * largest) << "contact " << k;
+    EXPECT_LE(P.segment<2>(3 * k + 1).norm(), r.friction[k] * P[3 * k] * (1 + 1e-12) + 1e-15) << "contact " << k;
+    with_friction_kept += P[3 * k] > 0 && P.segment<2>(3 * k + 1).norm() > 0;
+  }
+  EXPECT_GT(with_friction_kept, 0) << "the pushing contacts should keep friction";
+  // Energy only leaves (round-off allowed relative to what the impulses exchange).
+  EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
 }
 
 }  // namespace
