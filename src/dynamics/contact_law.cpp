@@ -545,15 +545,12 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
     // lose their friction for this solve, and the law is solved again: the others keep theirs.
     const double largest = *std::max_element(recent_change.begin(), recent_change.end());
     std::vector<ContactLawRow> calmer = law;
-    int unsettled = without_friction(law), with_friction = 0;
+    int with_friction = 0;
     for (int k = 0; k < m; ++k) {
-      if (!(rows[k].friction > 0)) continue;
-      ++with_friction;
-      if (calmer[k].friction > 0 && recent_change[k] >= kUnsettledFraction * largest) {
-        calmer[k].friction = 0;
-        ++unsettled;
-      }
+      with_friction += rows[k].friction > 0;
+      if (recent_change[k] >= kUnsettledFraction * largest) calmer[k].friction = 0;
     }
+    const int unsettled = without_friction(calmer);  // the cycling contacts too
     if (unsettled > 0 && unsettled < with_friction) {
       int sweeps = 0;
       // From the same start, less the friction of the contacts that lose it (on the same inputs, 1023
