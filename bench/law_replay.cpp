@@ -79,13 +79,10 @@ int main(int argc, char** argv) {
   for (std::size_t index = 0; index < records.size(); ++index) {
     const ContactLawRecord& r = records[index];
     const int m = r.contacts();
-    std::vector<ContactLawRow> rows(static_cast<std::size_t>(m));
-    for (int k = 0; k < m; ++k) rows[static_cast<std::size_t>(k)] = {r.target_normal[k], r.friction[k]};
-    const Eigen::VectorXd* start = r.start.size() > 0 ? &r.start : nullptr;
     ContactLawResult result;
     for (double& t : times) {
       const double before = thread_seconds();
-      result = solve_contact_law(r.K, r.u, rows, P, start);
+      result = solve_contact_law(r, P);
       t = thread_seconds() - before;
     }
     std::nth_element(times.begin(), times.begin() + repeat / 2, times.end());

@@ -587,6 +587,12 @@ ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::Vector
   return result;
 }
 
+ContactLawResult solve_contact_law(const ContactLawRecord& record, Eigen::VectorXd& P) {
+  std::vector<ContactLawRow> rows;
+  for (int k = 0; k < record.contacts(); ++k) rows.push_back({record.target_normal[k], record.friction[k]});
+  return solve_contact_law(record.K, record.u, rows, P, record.start.size() > 0 ? &record.start : nullptr);
+}
+
 namespace {
 
 // Projected Gauss-Seidel sweeps of the normal law from P_n, whose contact velocities are `velocity`

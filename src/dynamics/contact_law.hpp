@@ -22,6 +22,8 @@
 
 #include <vector>
 
+#include "aloft/contact_law_record.hpp"
+
 namespace aloft {
 
 struct ContactLawRow {
@@ -51,6 +53,10 @@ struct ContactLawResult {
 ContactLawResult solve_contact_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& u,
                                    const std::vector<ContactLawRow>& rows, Eigen::VectorXd& P,
                                    const Eigen::VectorXd* start = nullptr);
+
+// The same for a solve recorded from a simulation (Simulation::record_contact_laws), from its start if it
+// has one: the same law on the same machine gives its impulses again, bit for bit.
+ContactLawResult solve_contact_law(const ContactLawRecord& record, Eigen::VectorXd& P);
 
 // Normal-only variant (frictionless), used for the position correction: K_nn is m x m.
 void solve_normal_law(const Eigen::MatrixXd& K_nn, const Eigen::VectorXd& u_n, const Eigen::VectorXd& target,

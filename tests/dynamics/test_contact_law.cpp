@@ -669,10 +669,9 @@ TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
   const ContactLawRecord& r = records[0];
   const int m = r.contacts();
   ASSERT_EQ(m, 34);
-  std::vector<ContactLawRow> rows;
-  for (int k = 0; k < m; ++k) rows.push_back({r.target_normal[k], r.friction[k]});
+  ASSERT_EQ(r.start.size(), 0) << "recorded without a start: solved from zero";
   Eigen::VectorXd P;
-  const ContactLawResult result = solve_contact_law(r.K, r.u, rows, P);
+  const ContactLawResult result = solve_contact_law(r, P);
   // Bounds with room over the measured 37 and 1, below the 52 and 16 (or 143) without either rule.
   EXPECT_FALSE(result.friction_dropped);
   EXPECT_LE(result.frictionless_contacts, 3);

@@ -112,10 +112,8 @@ TEST(ContactLawRecord, RecordedSolvesGiveTheStepsImpulsesAgainAndLeaveTheMotionA
     ASSERT_EQ(r.impulses.size(), 3 * m);
     warm += r.start.size() > 0;
     several += m > 1;
-    std::vector<ContactLawRow> rows;
-    for (int k = 0; k < m; ++k) rows.push_back({r.target_normal[k], r.friction[k]});
     Eigen::VectorXd P;
-    solve_contact_law(r.K, r.u, rows, P, r.start.size() > 0 ? &r.start : nullptr);
+    solve_contact_law(r, P);
     ASSERT_EQ(P, r.impulses) << "solve " << (&r - records.data()) << " of " << m << " contacts";
   }
   std::printf("generated-127, 0.5 s knocking: %zu solves recorded (%d warm, %d of several contacts); the "
