@@ -22,7 +22,6 @@
 // them), as aloft_step_profile does.
 
 #include <benchmark/benchmark.h>
-#include <time.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -35,6 +34,7 @@
 #include "aloft/generate.hpp"
 #include "aloft/simulation.hpp"
 #include "bench_models.hpp"
+#include "thread_clock.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace {
@@ -74,15 +74,8 @@ const Entry& model_entry(const std::string& key) {
   return cache.emplace(key, std::move(entry)).first->second;
 }
 
-// Thread CPU time (s), as the benchmark's CPU column measures a single-threaded run.
-double cpu_seconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
 // items_per_second = steps per second; us_per_component_step from the CPU time of the timed loop
-// (cpu_seconds: seconds spent in the loop, measured by the caller around it).
+// (thread_seconds: seconds spent in the loop, measured by the caller around it).
 void set_counters(benchmark::State& state, const Model& model, double loop_seconds) {
   state.SetItemsProcessed(state.iterations());
   state.counters["components"] = model.count;
@@ -109,14 +102,14 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions, s
   const Model& model = *found;
   aloft::Simulation sim(model, aloft::bench::swinging_state(model, 0.5, seed));
   sim.set_collisions(collisions);
-  const double start = cpu_seconds();
+  const double start = aloft::bench::thread_seconds();
   for (auto _ : state) {
     if (!sim.step()) {
       state.SkipWithError(sim.failure()->message.c_str());
       break;
     }
   }
-  const double elapsed = cpu_seconds() - start;
+  const double elapsed = aloft::bench::thread_seconds() - start;
   benchmark::DoNotOptimize(sim.state().position.data());
   set_counters(state, model, elapsed);
   // How often a step was halved (step-size rule or unconverged joints) and the tree solves per step
@@ -151,12 +144,12 @@ void BM_Factor(benchmark::State& state, const std::string& key) {
   const Model& model = *found;
   const aloft::State pose = aloft::bench::swinging_state(model);
   aloft::TreeSolver solver(model);
-  const double start = cpu_seconds();
+  const double start = aloft::bench::thread_seconds();
   for (auto _ : state) {
     solver.factor(pose);
     benchmark::ClobberMemory();
   }
-  set_counters(state, model, cpu_seconds() - start);
+  set_counters(state, model, aloft::bench::thread_seconds() - start);
 }
 
 void BM_Solve(benchmark::State& state, const std::string& key) {
@@ -175,14 +168,14 @@ void BM_Solve(benchmark::State& state, const std::string& key) {
   }
   std::vector<aloft::Vec6> u(model.count, aloft::Vec6::Zero());
   std::vector<aloft::Vec3> lambda(model.count, aloft::Vec3::Zero());
-  const double start = cpu_seconds();
+  const double start = aloft::bench::thread_seconds();
   for (auto _ : state) {
     solver.solve(f, c, u, &lambda);
     benchmark::DoNotOptimize(u.data());
     benchmark::DoNotOptimize(lambda.data());
     benchmark::ClobberMemory();
   }
-  set_counters(state, model, cpu_seconds() - start);
+  set_counters(state, model, aloft::bench::thread_seconds() - start);
 }
 
 // Loading: generate_mobile text -> parse_mobile_text -> compile, the whole path a 65535-component file

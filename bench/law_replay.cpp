@@ -12,8 +12,6 @@
 // friction; and whether each solve gave the impulses the recording holds, bit for bit (the same law on
 // the same machine does), or how far it is from them (relative to the largest impulse of either).
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,14 +22,9 @@
 
 #include "aloft/contact_law_record.hpp"
 #include "dynamics/contact_law.hpp"
+#include "thread_clock.hpp"
 
 namespace {
-
-double thread_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 struct Outcome {
   const char* name;
@@ -81,9 +74,9 @@ int main(int argc, char** argv) {
     const int m = r.contacts();
     ContactLawResult result;
     for (double& t : times) {
-      const double before = thread_seconds();
+      const double before = bench::thread_seconds();
       result = solve_contact_law(r, P);
-      t = thread_seconds() - before;
+      t = bench::thread_seconds() - before;
     }
     std::nth_element(times.begin(), times.begin() + repeat / 2, times.end());
     const double seconds = times[static_cast<std::size_t>(repeat / 2)];

@@ -33,8 +33,6 @@
 // contacts left unsolved beyond ContactResponse::kMaxContacts (CollisionStatistics::law_solves ...), all
 // of the (sub)steps taken.
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -49,14 +47,9 @@
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
 #include "bench_models.hpp"
+#include "thread_clock.hpp"
 
 namespace {
-
-double thread_seconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 __attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
   for (long k = 0; k < steps; ++k)
@@ -221,9 +214,9 @@ int main(int argc, char** argv) {
       const long block = every > 0 ? std::min(every, steps - done) : steps;
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
-      const double start = thread_seconds();
+      const double start = bench::thread_seconds();
       if (!timed_steps(sim, block)) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = thread_seconds() - start;
+      const double block_seconds = bench::thread_seconds() - start;
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping
