@@ -654,6 +654,27 @@ TEST(ContactLaw, RowOfBeadsKnockedFromOneEndMovesOnTogether) {
   expect_row_of_beads_moves_on_together("full");
 }
 
+// The law holds at every contact of a recorded solve's impulses P: no approach beyond the target, no push
+// while separating, the impulse inside its cone (frictionless contacts: no tangential impulse).
+// Tolerances: 1e-9 of the velocities' scale, far above the sweeps' 1e-13 convergence and far below the
+// mm/s that matter. Returns how many pushing contacts kept a friction impulse.
+int expect_the_law_holds(const ContactLawRecord& r, const Eigen::VectorXd& P) {
+  const int m = r.contacts();
+  const Eigen::VectorXd after = r.u + r.K * P;
+  const double scale = std::max(r.u.cwiseAbs().maxCoeff(), r.target_normal.cwiseAbs().maxCoeff());
+  const double largest = P.cwiseAbs().maxCoeff();
+  int with_friction_kept = 0;
+  for (int k = 0; k < m; ++k) {
+    const double beyond = after[3 * k] - r.target_normal[k];
+    EXPECT_GE(beyond, -1e-9 * scale) << "contact " << k;
+    EXPECT_GE(P[3 * k], 0.0) << "contact " << k;
+    EXPECT_LE(std::abs(P[3 * k] * beyond), 1e-9 * scale * largest) << "contact " << k;
+    EXPECT_LE(P.segment<2>(3 * k + 1).norm(), r.friction[k] * P[3 * k] * (1 + 1e-12) + 1e-15) << "contact " << k;
+    with_friction_kept += P[3 * k] > 0 && P.segment<2>(3 * k + 1).norm() > 0;
+  }
+  return with_friction_kept;
+}
+
 // A solve recorded from the tangle of generated-1023 (`aloft_step_profile --record-law ... --record-every 10
 // --record-min 5 1023 5000 1 swinging:1`, its 227th record; tests/data/generated-1023-tangle-solve.law):
 // 34 contacts, mu 0.4, no start. Two rules of the law decide how it ends (contact_law.cpp): a contact that
@@ -676,23 +697,38 @@ TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
   EXPECT_FALSE(result.friction_dropped);
   EXPECT_LE(result.frictionless_contacts, 3);
   EXPECT_LE(result.iterations, 45);
-  // The law holds at every contact: no approach beyond the target, no push while separating, the impulse
-  // inside its cone (frictionless contacts: no tangential impulse). Tolerances: 1e-9 of the velocities'
-  // scale, far above the sweeps' 1e-13 convergence and far below the mm/s that matter.
-  const Eigen::VectorXd after = r.u + r.K * P;
-  const double scale = std::max(r.u.cwiseAbs().maxCoeff(), r.target_normal.cwiseAbs().maxCoeff());
-  const double largest = P.cwiseAbs().maxCoeff();
-  int with_friction_kept = 0;
-  for (int k = 0; k < m; ++k) {
-    const double beyond = after[3 * k] - r.target_normal[k];
-    EXPECT_GE(beyond, -1e-9 * scale) << "contact " << k;
-    EXPECT_GE(P[3 * k], 0.0) << "contact " << k;
-    EXPECT_LE(std::abs(P[3 * k] * beyond), 1e-9 * scale * largest) << "contact " << k;
-    EXPECT_LE(P.segment<2>(3 * k + 1).norm(), r.friction[k] * P[3 * k] * (1 + 1e-12) + 1e-15) << "contact " << k;
-    with_friction_kept += P[3 * k] > 0 && P.segment<2>(3 * k + 1).norm() > 0;
-  }
-  EXPECT_GT(with_friction_kept, 0) << "the pushing contacts should keep friction";
+  EXPECT_GT(expect_the_law_holds(r, P), 0) << "the pushing contacts should keep friction";
   // Energy only leaves (round-off allowed relative to what the impulses exchange).
+  EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
+}
+
+// A solve recorded from generated-1023 (the same command as above, its 967th record;
+// tests/data/generated-1023-lu-polish-solve.law): 36 contacts, mu 0.4, no start, recorded with the law of
+// a2ad824, whose polish factored every cluster by the complete orthogonal decomposition. Its polishes now
+// go by LU (clusters of 12 contacts or more, reciprocal condition at least 1e-8: contact_law.cpp,
+// kPolishLuContacts). Measured: 22 sweeps, friction kept at every contact, the impulses within 1.6e-14 of
+// the largest of the recorded ones. With the LU steps taken as zero (no polish), 49 sweeps; with them
+// 1.5 times too long, 22 sweeps but 2.7e-10 from the recorded impulses.
+TEST(ContactLaw, APolishFactoredByLuGivesTheDecompositionsImpulses) {
+  const std::string path = std::string(ALOFT_SOURCE_DIR) + "/tests/data/generated-1023-lu-polish-solve.law";
+  const std::vector<ContactLawRecord> records = read_contact_law_records(path);
+  ASSERT_EQ(records.size(), 1u);
+  const ContactLawRecord& r = records[0];
+  ASSERT_EQ(r.contacts(), 36);
+  ASSERT_EQ(r.start.size(), 0) << "recorded without a start: solved from zero";
+  Eigen::VectorXd P;
+  const ContactLawResult result = solve_contact_law(r, P);
+  EXPECT_FALSE(result.friction_dropped);
+  EXPECT_EQ(result.frictionless_contacts, 0);
+  // Room over the measured 22 sweeps, below the 49 the sweeps take without the polish's steps.
+  EXPECT_LE(result.iterations, 26);
+  // Both factorizations solve the same well-conditioned system, so the impulses agree to round-off: 1e-12
+  // of the largest, 60 times the measured 1.6e-14 and below the 2.7e-10 of steps 1.5 times too long.
+  const double largest = r.impulses.cwiseAbs().maxCoeff();
+  EXPECT_LE((P - r.impulses).cwiseAbs().maxCoeff(), 1e-12 * largest);
+  int pushing = 0;
+  for (int k = 0; k < r.contacts(); ++k) pushing += P[3 * k] > 0;
+  EXPECT_EQ(expect_the_law_holds(r, P), pushing) << "every pushing contact keeps its friction";
   EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
 }
 
