@@ -654,6 +654,16 @@ TEST(ContactLaw, RowOfBeadsKnockedFromOneEndMovesOnTogether) {
   expect_row_of_beads_moves_on_together("full");
 }
 
+// The one solve recorded in tests/data/<file>, which both tests below recorded without a start (solved
+// from zero). (at() throws, failing the test, if the file holds none.)
+ContactLawRecord recorded_solve(const std::string& file) {
+  const std::vector<ContactLawRecord> records =
+      read_contact_law_records(std::string(ALOFT_SOURCE_DIR) + "/tests/data/" + file);
+  EXPECT_EQ(records.size(), 1u) << file;
+  EXPECT_EQ(records.at(0).start.size(), 0) << file << ": recorded without a start";
+  return records.at(0);
+}
+
 // The law holds at every contact of a recorded solve's impulses P: no approach beyond the target, no push
 // while separating, the impulse inside its cone (frictionless contacts: no tangential impulse).
 // Tolerances: 1e-9 of the velocities' scale, far above the sweeps' 1e-13 convergence and far below the
@@ -684,13 +694,8 @@ int expect_the_law_holds(const ContactLawRecord& r, const Eigen::VectorXd& P) {
 // before the seventh session of 2026-12-06), 52 sweeps and friction lost at 16 contacts (the sweeps did
 // not converge and the contacts that kept changing were solved again without it).
 TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
-  const std::string path = std::string(ALOFT_SOURCE_DIR) + "/tests/data/generated-1023-tangle-solve.law";
-  const std::vector<ContactLawRecord> records = read_contact_law_records(path);
-  ASSERT_EQ(records.size(), 1u);
-  const ContactLawRecord& r = records[0];
-  const int m = r.contacts();
-  ASSERT_EQ(m, 34);
-  ASSERT_EQ(r.start.size(), 0) << "recorded without a start: solved from zero";
+  const ContactLawRecord r = recorded_solve("generated-1023-tangle-solve.law");
+  ASSERT_EQ(r.contacts(), 34);
   Eigen::VectorXd P;
   const ContactLawResult result = solve_contact_law(r, P);
   // Bounds with room over the measured 37 and 1, below the 52 and 16 (or 143) without either rule.
@@ -710,12 +715,8 @@ TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
 // the largest of the recorded ones. With the LU steps taken as zero (no polish), 49 sweeps; with them
 // 1.5 times too long, 22 sweeps but 2.7e-10 from the recorded impulses.
 TEST(ContactLaw, APolishFactoredByLuGivesTheDecompositionsImpulses) {
-  const std::string path = std::string(ALOFT_SOURCE_DIR) + "/tests/data/generated-1023-lu-polish-solve.law";
-  const std::vector<ContactLawRecord> records = read_contact_law_records(path);
-  ASSERT_EQ(records.size(), 1u);
-  const ContactLawRecord& r = records[0];
+  const ContactLawRecord r = recorded_solve("generated-1023-lu-polish-solve.law");
   ASSERT_EQ(r.contacts(), 36);
-  ASSERT_EQ(r.start.size(), 0) << "recorded without a start: solved from zero";
   Eigen::VectorXd P;
   const ContactLawResult result = solve_contact_law(r, P);
   EXPECT_FALSE(result.friction_dropped);
