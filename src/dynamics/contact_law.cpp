@@ -8,6 +8,8 @@
 
 #include <Eigen/LU>
 
+#include "aloft/contact_law_record.hpp"
+
 namespace aloft {
 
 namespace {
@@ -433,9 +435,11 @@ bool polish_law(const Eigen::MatrixXd& K, const Eigen::VectorXd& velocity, const
   // with a zero row and column, where the solve would divide by zero. Rows equal to round-off give
   // 1e-33.)
   Eigen::PartialPivLU<Eigen::MatrixXd> lu;
-  if (c >= kPolishLuContacts) lu.compute(J);
-  const bool well_conditioned = c >= kPolishLuContacts && lu.matrixLU().diagonal().cwiseAbs().minCoeff() > 0 &&
-                                lu.rcond() >= kPolishLuConditioning;
+  bool well_conditioned = false;
+  if (c >= kPolishLuContacts) {
+    lu.compute(J);
+    well_conditioned = lu.matrixLU().diagonal().cwiseAbs().minCoeff() > 0 && lu.rcond() >= kPolishLuConditioning;
+  }
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> rank_revealing;
   if (!well_conditioned) {
     rank_revealing.setThreshold(kPolishRank);

@@ -22,9 +22,9 @@
 
 #include <vector>
 
-#include "aloft/contact_law_record.hpp"
-
 namespace aloft {
+
+struct ContactLawRecord;  // aloft/contact_law_record.hpp
 
 struct ContactLawRow {
   double target_normal = 0;  // m/s: the least normal relative velocity allowed after the impulse
