@@ -667,8 +667,10 @@ ContactLawRecord recorded_solve(const std::string& file) {
 // The law holds at every contact of a recorded solve's impulses P: no approach beyond the target, no push
 // while separating, the impulse inside its cone (frictionless contacts: no tangential impulse).
 // Tolerances: 1e-9 of the velocities' scale, far above the sweeps' 1e-13 convergence and far below the
-// mm/s that matter. Returns how many pushing contacts kept a friction impulse.
-int expect_the_law_holds(const ContactLawRecord& r, const Eigen::VectorXd& P) {
+// mm/s that matter. And the solve's energy only leaves (round-off allowed relative to what the impulses
+// exchange). Returns how many pushing contacts kept a friction impulse.
+int expect_the_law_holds(const ContactLawRecord& r, const Eigen::VectorXd& P, const ContactLawResult& result) {
+  EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
   const int m = r.contacts();
   const Eigen::VectorXd after = r.u + r.K * P;
   const double scale = std::max(r.u.cwiseAbs().maxCoeff(), r.target_normal.cwiseAbs().maxCoeff());
@@ -702,9 +704,7 @@ TEST(ContactLaw, ARecordedTangleKeepsItsFrictionAndConverges) {
   EXPECT_FALSE(result.friction_dropped);
   EXPECT_LE(result.frictionless_contacts, 3);
   EXPECT_LE(result.iterations, 45);
-  EXPECT_GT(expect_the_law_holds(r, P), 0) << "the pushing contacts should keep friction";
-  // Energy only leaves (round-off allowed relative to what the impulses exchange).
-  EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
+  EXPECT_GT(expect_the_law_holds(r, P, result), 0) << "the pushing contacts should keep friction";
 }
 
 // A solve recorded from generated-1023 (the same command as above, its 967th record;
@@ -729,8 +729,7 @@ TEST(ContactLaw, APolishFactoredByLuGivesTheDecompositionsImpulses) {
   EXPECT_LE((P - r.impulses).cwiseAbs().maxCoeff(), 1e-12 * largest);
   int pushing = 0;
   for (int k = 0; k < r.contacts(); ++k) pushing += P[3 * k] > 0;
-  EXPECT_EQ(expect_the_law_holds(r, P), pushing) << "every pushing contact keeps its friction";
-  EXPECT_LE(result.energy_change, 1e-12 * std::abs(r.u.dot(P)));
+  EXPECT_EQ(expect_the_law_holds(r, P, result), pushing) << "every pushing contact keeps its friction";
 }
 
 }  // namespace
