@@ -34,7 +34,7 @@
 #include "aloft/generate.hpp"
 #include "aloft/simulation.hpp"
 #include "bench_models.hpp"
-#include "thread_clock.hpp"
+#include "aloft/thread_clock.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace {
@@ -102,14 +102,14 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions, s
   const Model& model = *found;
   aloft::Simulation sim(model, aloft::bench::swinging_state(model, 0.5, seed));
   sim.set_collisions(collisions);
-  const double start = aloft::bench::thread_seconds();
+  const double start = aloft::thread_seconds();
   for (auto _ : state) {
     if (!sim.step()) {
       state.SkipWithError(sim.failure()->message.c_str());
       break;
     }
   }
-  const double elapsed = aloft::bench::thread_seconds() - start;
+  const double elapsed = aloft::thread_seconds() - start;
   benchmark::DoNotOptimize(sim.state().position.data());
   set_counters(state, model, elapsed);
   // How often a step was halved (step-size rule or unconverged joints) and the tree solves per step
@@ -144,12 +144,12 @@ void BM_Factor(benchmark::State& state, const std::string& key) {
   const Model& model = *found;
   const aloft::State pose = aloft::bench::swinging_state(model);
   aloft::TreeSolver solver(model);
-  const double start = aloft::bench::thread_seconds();
+  const double start = aloft::thread_seconds();
   for (auto _ : state) {
     solver.factor(pose);
     benchmark::ClobberMemory();
   }
-  set_counters(state, model, aloft::bench::thread_seconds() - start);
+  set_counters(state, model, aloft::thread_seconds() - start);
 }
 
 void BM_Solve(benchmark::State& state, const std::string& key) {
@@ -168,14 +168,14 @@ void BM_Solve(benchmark::State& state, const std::string& key) {
   }
   std::vector<aloft::Vec6> u(model.count, aloft::Vec6::Zero());
   std::vector<aloft::Vec3> lambda(model.count, aloft::Vec3::Zero());
-  const double start = aloft::bench::thread_seconds();
+  const double start = aloft::thread_seconds();
   for (auto _ : state) {
     solver.solve(f, c, u, &lambda);
     benchmark::DoNotOptimize(u.data());
     benchmark::DoNotOptimize(lambda.data());
     benchmark::ClobberMemory();
   }
-  set_counters(state, model, aloft::bench::thread_seconds() - start);
+  set_counters(state, model, aloft::thread_seconds() - start);
 }
 
 // Loading: generate_mobile text -> parse_mobile_text -> compile, the whole path a 65535-component file

@@ -22,7 +22,7 @@
 
 #include "aloft/contact_law_record.hpp"
 #include "dynamics/contact_law.hpp"
-#include "thread_clock.hpp"
+#include "aloft/thread_clock.hpp"
 
 namespace {
 
@@ -74,9 +74,9 @@ int main(int argc, char** argv) {
     const int m = r.contacts();
     ContactLawResult result;
     for (double& t : times) {
-      const double before = bench::thread_seconds();
+      const double before = thread_seconds();
       result = solve_contact_law(r, P);
-      t = bench::thread_seconds() - before;
+      t = thread_seconds() - before;
     }
     std::nth_element(times.begin(), times.begin() + repeat / 2, times.end());
     const double seconds = times[static_cast<std::size_t>(repeat / 2)];

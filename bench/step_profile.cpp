@@ -47,7 +47,7 @@
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
 #include "bench_models.hpp"
-#include "thread_clock.hpp"
+#include "aloft/thread_clock.hpp"
 
 namespace {
 
@@ -214,9 +214,9 @@ int main(int argc, char** argv) {
       const long block = every > 0 ? std::min(every, steps - done) : steps;
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
-      const double start = bench::thread_seconds();
+      const double start = thread_seconds();
       if (!timed_steps(sim, block)) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = bench::thread_seconds() - start;
+      const double block_seconds = thread_seconds() - start;
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping

@@ -3,8 +3,6 @@
 // mobile is set swinging by a breeze (0.2 g for 0.3 s), then timed over 5 repetitions of enough steps
 // for at least 0.5 s each (or --steps); the median is reported.
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +15,7 @@
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
+#include "aloft/thread_clock.hpp"
 #include "common.hpp"
 
 #ifndef ALOFT_BUILD_TYPE
@@ -26,14 +25,6 @@
 namespace aloft::cli {
 
 namespace {
-
-// The CPU time of this thread (s). On a machine shared with other work, wall-clock time counts the time
-// the thread waited for a core; the thread's own CPU time does not (it still feels shared caches).
-double thread_seconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 double seconds_since(double start) { return thread_seconds() - start; }
 
