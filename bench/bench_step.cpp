@@ -33,8 +33,8 @@
 
 #include "aloft/generate.hpp"
 #include "aloft/simulation.hpp"
-#include "bench_models.hpp"
 #include "aloft/thread_clock.hpp"
+#include "bench_models.hpp"
 #include "dynamics/tree_solver.hpp"
 
 namespace {

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "aloft/contact_law_record.hpp"
-#include "dynamics/contact_law.hpp"
 #include "aloft/thread_clock.hpp"
+#include "dynamics/contact_law.hpp"
 
 namespace {
 

@@ -46,8 +46,8 @@
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
-#include "bench_models.hpp"
 #include "aloft/thread_clock.hpp"
+#include "bench_models.hpp"
 
 namespace {
 
