@@ -9,9 +9,15 @@
 //      Fish: CPU time per step (median of interleaved repetitions A B C A B C ...), per moving
 //      component, relative to Aloft; and over `--seconds` of swinging from the same state, the energy
 //      drift (end and largest, relative to the initial kinetic energy) and the largest joint separation.
-// All at h = 1 ms, one thread, no damping, no collisions.
+//   3. Collisions (--collisions; Aloft and Bullet): the cost of a span from the swinging state with
+//      collisions off and on, in each engine (issue 3's target is Aloft's on / off <= 2 up to 8191
+//      components; docs/performance.md), with the contact points, the deepest overlap and the energy the
+//      span ends with. Generated mobiles tangle (their pieces are packed within each other's reach), so
+//      both engines meet knocks and resting contacts.
+// All at h = 1 ms, one thread, no damping; no collisions but in 3.
 
 #include <LinearMath/btScalar.h>
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
 #include <time.h>
 
 #include <algorithm>
@@ -44,6 +50,11 @@ struct Options {
   double accuracy_max = 1e9;    // skip the drift run above this many components
   bool trajectory = true;
   bool table = true;
+  bool collisions = false;                       // section 3
+  std::vector<int> collision_sizes = {127, 1023};
+  std::vector<int> collision_seeds = {7};        // of the swinging state (bench_models.hpp)
+  long long collision_steps = 0;                 // 0: BM_StepSpan's span for the size
+  double bullet_contact_threshold = -1;          // gContactBreakingThreshold; < 0: Bullet's default
 };
 
 double cpu_seconds() {
@@ -251,6 +262,76 @@ std::string cost_and_accuracy(const Model& model, const std::string& label, cons
   return note.str();
 }
 
+// ---- 3. Collisions ---------------------------------------------------------------------------------
+
+// BM_StepSpan's number of steps for a generated mobile of `components` (bench/bench_step.cpp).
+long long span_steps(int components) {
+  if (components <= 15) return 20000;
+  if (components <= 127) return 10000;
+  if (components <= 1023) return 5000;
+  return 2000;
+}
+
+struct SpanRun {
+  double step = NAN;           // s of thread CPU per step
+  double points = 0;           // contact points per step (the engine's own count)
+  double deepest = 0;          // m
+  double energy_change = 0;    // (E(end) - E(0)) / KE(0)
+  std::string error;
+};
+
+SpanRun run_span(Kind kind, const Model& model, const State& initial, long long steps, bool collisions,
+                 const std::string& label) {
+  SpanRun r;
+  try {
+    auto engine = kind == Kind::Aloft ? aloft::compare::make_aloft(model, initial, model.timestep, collisions)
+                                      : aloft::compare::make_bullet(model, initial, model.timestep, collisions);
+    State s = initial;
+    engine->read(s);
+    const double kinetic0 = aloft::kinetic_energy(model, s);
+    const double energy0 = kinetic0 + aloft::potential_energy(model, s);
+    double seconds = 0;
+    long long points = 0;
+    const long long report_every = std::max<long long>(1, steps / 5);
+    for (long long k = 1; k <= steps; ++k) {
+      const double t0 = cpu_seconds();
+      engine->step();
+      seconds += cpu_seconds() - t0;
+      points += engine->contact_points();
+      if (k % report_every == 0)
+        std::fprintf(stderr, "[%s] %s %s: %lld of %lld steps, %.1f us per step so far\n", label.c_str(),
+                     kind_name(kind), collisions ? "on" : "off", k, steps, 1e6 * seconds / k);
+    }
+    engine->read(s);
+    r.step = seconds / steps;
+    r.points = static_cast<double>(points) / steps;
+    r.deepest = engine->deepest_overlap();
+    r.energy_change = (aloft::kinetic_energy(model, s) + aloft::potential_energy(model, s) - energy0) / kinetic0;
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  }
+  return r;
+}
+
+// One row per engine: off, then on, one run each (a span is seconds to minutes, and with collisions
+// the motion is chaotic, so the seeds, not repetitions, are what to vary).
+void collision_cost(const Model& model, const std::string& label, int seed, long long steps) {
+  const State initial = aloft::bench::swinging_state(model, 0.5, static_cast<std::uint64_t>(seed));
+  for (Kind kind : {Kind::Aloft, Kind::Bullet}) {
+    const std::string run = label + " seed " + std::to_string(seed);
+    const SpanRun off = run_span(kind, model, initial, steps, false, run);
+    const SpanRun on = run_span(kind, model, initial, steps, true, run);
+    std::printf("| %s | %d | %d | %s | %lld |", label.c_str(), model.count, seed, kind_name(kind), steps);
+    if (!off.error.empty() || !on.error.empty()) {
+      std::printf(" failed: %s | | | | | |\n", (off.error.empty() ? on.error : off.error).c_str());
+    } else {
+      std::printf(" %.1f | %.1f | %.2f | %.1f | %.3f | %+.2e |\n", off.step * 1e6, on.step * 1e6, on.step / off.step,
+                  on.points, on.deepest * 1e3, on.energy_change);
+    }
+    std::fflush(stdout);
+  }
+}
+
 // ---- Command line ----------------------------------------------------------------------------------
 
 std::vector<int> parse_sizes(const std::string& text) {
@@ -266,7 +347,12 @@ void usage() {
   std::printf(
       "usage: aloft_compare [--sizes 15,127,1023,8191] [--no-preset] [--reps 5] [--seconds 10]\n"
       "                     [--budget 0.2] [--ode-step-max 200] [--accuracy-max N]\n"
-      "                     [--no-trajectory] [--no-table]\n");
+      "                     [--no-trajectory] [--no-table]\n"
+      "                     [--collisions [--collision-sizes 127,1023] [--collision-seeds 7]\n"
+      "                      [--collision-steps N] [--bullet-contact-threshold M]]\n"
+      "  --collisions: also time a span from the swinging state with collisions off and on, in Aloft\n"
+      "    and Bullet (N steps; default BM_StepSpan's: 10000 up to 127 components, 5000 up to 1023,\n"
+      "    2000 above); M: Bullet's gContactBreakingThreshold (default its own, 0.02)\n");
 }
 
 }  // namespace
@@ -291,6 +377,11 @@ int main(int argc, char** argv) {
     else if (arg == "--accuracy-max") options.accuracy_max = std::stod(value());
     else if (arg == "--no-trajectory") options.trajectory = false;
     else if (arg == "--no-table") options.table = false;
+    else if (arg == "--collisions") options.collisions = true;
+    else if (arg == "--collision-sizes") options.collision_sizes = parse_sizes(value());
+    else if (arg == "--collision-seeds") options.collision_seeds = parse_sizes(value());
+    else if (arg == "--collision-steps") options.collision_steps = std::stoll(value());
+    else if (arg == "--bullet-contact-threshold") options.bullet_contact_threshold = std::stod(value());
     else {
       usage();
       return arg == "--help" || arg == "-h" ? 0 : 2;
@@ -300,7 +391,8 @@ int main(int argc, char** argv) {
   try {
     std::printf("# aloft_compare\n\n%s\nBullet %d (double precision btMultiBody, spherical joints).\n",
                 aloft::compare::ode_configuration().c_str(), btGetVersion());
-    std::printf("h = 1 ms, one thread, no damping, no collisions; time = thread CPU time per step, median of "
+    std::printf("h = 1 ms, one thread, no damping, no collisions (but in the collisions section); time = thread "
+                "CPU time per step, median of "
                 "%d interleaved repetitions.\n",
                 options.repetitions);
 
@@ -332,6 +424,26 @@ int main(int argc, char** argv) {
       if (fish_model) notes.push_back(cost_and_accuracy(*fish_model, "steel-fish", options));
       std::printf("\n");
       for (const std::string& note : notes) std::printf("- %s\n", note.c_str());
+    }
+
+    if (options.collisions) {
+      if (options.bullet_contact_threshold >= 0) gContactBreakingThreshold = options.bullet_contact_threshold;
+      std::printf("\n## Collisions: a span from the swinging state, off and on (Bullet's contact breaking "
+                  "threshold %g)\n\n",
+                  static_cast<double>(gContactBreakingThreshold));
+      std::printf("Thread CPU time per step over the whole span, one run each; contact points per step with "
+                  "collisions on (each engine's own count); the deepest overlap seen; the energy at the "
+                  "span's end against its start, over the initial kinetic energy.\n\n");
+      std::printf("| mobile | comps | seed | engine | steps | off us/step | on us/step | on / off | contact "
+                  "points per step | deepest overlap (mm) | dE(end)/KE0, on |\n"
+                  "|---|---|---|---|---|---|---|---|---|---|---|\n");
+      std::fflush(stdout);
+      for (int n : options.collision_sizes) {
+        auto m = aloft::bench::generated_model(n, 1);
+        const long long steps = options.collision_steps > 0 ? options.collision_steps : span_steps(n);
+        for (int seed : options.collision_seeds)
+          collision_cost(*m, "generated-" + std::to_string(n), seed, steps);
+      }
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aloft_compare: %s\n", e.what());
