@@ -361,30 +361,36 @@ int main(int argc, char** argv) {
   Options options;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
+    try {
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) {
+          usage();
+          std::exit(2);
+        }
+        return argv[++i];
+      };
+      if (arg == "--sizes") options.sizes = parse_sizes(value());
+      else if (arg == "--no-preset") options.preset = false;
+      else if (arg == "--reps") options.repetitions = std::stoi(value());
+      else if (arg == "--seconds") options.seconds = std::stod(value());
+      else if (arg == "--budget") options.budget = std::stod(value());
+      else if (arg == "--ode-step-max") options.ode_step_max = std::stoi(value());
+      else if (arg == "--accuracy-max") options.accuracy_max = std::stod(value());
+      else if (arg == "--no-trajectory") options.trajectory = false;
+      else if (arg == "--no-table") options.table = false;
+      else if (arg == "--collisions") options.collisions = true;
+      else if (arg == "--collision-sizes") options.collision_sizes = parse_sizes(value());
+      else if (arg == "--collision-seeds") options.collision_seeds = parse_sizes(value());
+      else if (arg == "--collision-steps") options.collision_steps = std::stoll(value());
+      else if (arg == "--bullet-contact-threshold") options.bullet_contact_threshold = std::stod(value());
+      else {
         usage();
-        std::exit(2);
+        return arg == "--help" || arg == "-h" ? 0 : 2;
       }
-      return argv[++i];
-    };
-    if (arg == "--sizes") options.sizes = parse_sizes(value());
-    else if (arg == "--no-preset") options.preset = false;
-    else if (arg == "--reps") options.repetitions = std::stoi(value());
-    else if (arg == "--seconds") options.seconds = std::stod(value());
-    else if (arg == "--budget") options.budget = std::stod(value());
-    else if (arg == "--ode-step-max") options.ode_step_max = std::stoi(value());
-    else if (arg == "--accuracy-max") options.accuracy_max = std::stod(value());
-    else if (arg == "--no-trajectory") options.trajectory = false;
-    else if (arg == "--no-table") options.table = false;
-    else if (arg == "--collisions") options.collisions = true;
-    else if (arg == "--collision-sizes") options.collision_sizes = parse_sizes(value());
-    else if (arg == "--collision-seeds") options.collision_seeds = parse_sizes(value());
-    else if (arg == "--collision-steps") options.collision_steps = std::stoll(value());
-    else if (arg == "--bullet-contact-threshold") options.bullet_contact_threshold = std::stod(value());
-    else {
-      usage();
-      return arg == "--help" || arg == "-h" ? 0 : 2;
+    } catch (const std::logic_error&) {  // std::stoi and friends: not a number, or out of range
+      std::fprintf(stderr, "aloft_compare: %s takes a number (a comma-separated list for the sizes and seeds), not '%s'\n",
+                   arg.c_str(), argv[i]);
+      return 2;
     }
   }
 
