@@ -40,6 +40,17 @@ inline std::unique_ptr<Model> preset_model(const std::string& name) {
   return std::make_unique<Model>(load_mobile(preset_path(name)));
 }
 
+// BM_StepSpan's fixed number of steps (1 ms each) from the swinging state for a generated mobile of
+// `components`: a few simulated seconds where that takes seconds to time, so that knocks and quiet
+// stretches both count (aloft_compare --collisions times the same spans).
+inline int span_steps(int components) {
+  if (components <= 15) return 20000;
+  if (components <= 127) return 10000;
+  if (components <= 1023) return 5000;
+  if (components <= 8191) return 2000;
+  return 30;
+}
+
 // The designed pose with a random angular velocity (world, uniform direction, magnitude uniform in
 // [rate/2, rate] rad/s) on every moving component, and centre-of-mass velocities that keep every joint
 // together: v_i = v_p + w_p x (j_i - x_p) + w_i x (x_i - j_i). Same seed, same state on every machine

@@ -128,16 +128,6 @@ void BM_Step(benchmark::State& state, const std::string& key, bool collisions, s
   }
 }
 
-// BM_StepSpan's fixed number of steps (1 ms each) from the swinging state: a few simulated seconds
-// where that takes seconds to time, so that knocks and quiet stretches both count.
-int span_steps(int components) {
-  if (components <= 15) return 20000;
-  if (components <= 127) return 10000;
-  if (components <= 1023) return 5000;
-  if (components <= 8191) return 2000;
-  return 30;
-}
-
 void BM_Factor(benchmark::State& state, const std::string& key) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
@@ -210,7 +200,7 @@ void register_all() {
     for (const bool collisions : {false, true})
       benchmark::RegisterBenchmark(("BM_StepSpan/" + key + (collisions ? "/on" : "/off")).c_str(), BM_Step, key,
                                    collisions, kSeed)
-          ->Iterations(span_steps(components))
+          ->Iterations(aloft::bench::span_steps(components))
           ->Unit(benchmark::kMicrosecond);
   }
   // The generated mobiles' spans from more swinging states: a tangle's cost differs by half between
@@ -224,7 +214,7 @@ void register_all() {
         benchmark::RegisterBenchmark(
             ("BM_StepSpanSeeds/" + key + (collisions ? "/on" : "/off") + "/seed:" + std::to_string(seed)).c_str(),
             BM_Step, key, collisions, seed)
-            ->Iterations(span_steps(components))
+            ->Iterations(aloft::bench::span_steps(components))
             ->Unit(benchmark::kMicrosecond);
   }
   for (const std::string& key : keys)

@@ -18,7 +18,6 @@
 
 #include <LinearMath/btScalar.h>
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
-#include <time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "aloft/thread_clock.hpp"
 #include "bench_models.hpp"
 #include "compare/engine.hpp"
 
@@ -56,12 +56,6 @@ struct Options {
   long long collision_steps = 0;                 // 0: BM_StepSpan's span for the size
   double bullet_contact_threshold = -1;          // gContactBreakingThreshold; < 0: Bullet's default
 };
-
-double cpu_seconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -198,13 +192,13 @@ std::string cost_and_accuracy(const Model& model, const std::string& label, cons
       try {
         r.engine = make(k, model, initial, model.timestep);
         // Calibrate: steps per sample so that one sample takes about `budget` seconds of CPU.
-        const double t0 = cpu_seconds();
+        const double t0 = aloft::thread_seconds();
         long long n = 0;
         do {
           r.engine->step();
           ++n;
-        } while (cpu_seconds() - t0 < 0.02);
-        const double per_step = (cpu_seconds() - t0) / n;
+        } while (aloft::thread_seconds() - t0 < 0.02);
+        const double per_step = (aloft::thread_seconds() - t0) / n;
         r.steps_per_sample = std::clamp<long long>(std::llround(options.budget / per_step), 1, 1000000);
       } catch (const std::exception& e) {
         r.error = e.what();
@@ -219,9 +213,9 @@ std::string cost_and_accuracy(const Model& model, const std::string& label, cons
     for (Row& r : rows) {
       if (!r.engine) continue;
       try {
-        const double t0 = cpu_seconds();
+        const double t0 = aloft::thread_seconds();
         for (long long k = 0; k < r.steps_per_sample; ++k) r.engine->step();
-        r.samples.push_back((cpu_seconds() - t0) / r.steps_per_sample);
+        r.samples.push_back((aloft::thread_seconds() - t0) / r.steps_per_sample);
       } catch (const std::exception& e) {
         r.error = e.what();
         r.engine.reset();
@@ -264,14 +258,6 @@ std::string cost_and_accuracy(const Model& model, const std::string& label, cons
 
 // ---- 3. Collisions ---------------------------------------------------------------------------------
 
-// BM_StepSpan's number of steps for a generated mobile of `components` (bench/bench_step.cpp).
-long long span_steps(int components) {
-  if (components <= 15) return 20000;
-  if (components <= 127) return 10000;
-  if (components <= 1023) return 5000;
-  return 2000;
-}
-
 struct SpanRun {
   double step = NAN;           // s of thread CPU per step
   double points = 0;           // contact points per step (the engine's own count)
@@ -294,9 +280,9 @@ SpanRun run_span(Kind kind, const Model& model, const State& initial, long long 
     long long points = 0;
     const long long report_every = std::max<long long>(1, steps / 5);
     for (long long k = 1; k <= steps; ++k) {
-      const double t0 = cpu_seconds();
+      const double t0 = aloft::thread_seconds();
       engine->step();
-      seconds += cpu_seconds() - t0;
+      seconds += aloft::thread_seconds() - t0;
       points += engine->contact_points();
       if (k % report_every == 0)
         std::fprintf(stderr, "[%s] %s %s: %lld of %lld steps, %.1f us per step so far\n", label.c_str(),
@@ -352,7 +338,7 @@ void usage() {
       "                      [--collision-steps N] [--bullet-contact-threshold M]]\n"
       "  --collisions: also time a span from the swinging state with collisions off and on, in Aloft\n"
       "    and Bullet (N steps; default BM_StepSpan's: 10000 up to 127 components, 5000 up to 1023,\n"
-      "    2000 above); M: Bullet's gContactBreakingThreshold (default its own, 0.02)\n");
+      "    2000 up to 8191, bench_models.hpp span_steps); M: Bullet's gContactBreakingThreshold (default its own, 0.02)\n");
 }
 
 }  // namespace
@@ -446,7 +432,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       for (int n : options.collision_sizes) {
         auto m = aloft::bench::generated_model(n, 1);
-        const long long steps = options.collision_steps > 0 ? options.collision_steps : span_steps(n);
+        const long long steps = options.collision_steps > 0 ? options.collision_steps : aloft::bench::span_steps(n);
         for (int seed : options.collision_seeds)
           collision_cost(*m, "generated-" + std::to_string(n), seed, steps);
       }
