@@ -27,6 +27,7 @@
 #include <functional>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -74,10 +75,13 @@ const char* kind_name(Kind k) {
   return "?";
 }
 
-std::unique_ptr<Engine> make(Kind kind, const Model& model, const State& initial, double h) {
+// With `collisions` (Aloft and Bullet only; ODE is built without colliders).
+std::unique_ptr<Engine> make(Kind kind, const Model& model, const State& initial, double h, bool collisions = false) {
+  if (collisions && (kind == Kind::OdeStep || kind == Kind::OdeQuick))
+    throw std::invalid_argument("aloft_compare builds ODE without colliders");
   switch (kind) {
-    case Kind::Aloft: return aloft::compare::make_aloft(model, initial, h);
-    case Kind::Bullet: return aloft::compare::make_bullet(model, initial, h);
+    case Kind::Aloft: return aloft::compare::make_aloft(model, initial, h, collisions);
+    case Kind::Bullet: return aloft::compare::make_bullet(model, initial, h, collisions);
     case Kind::OdeStep: return aloft::compare::make_ode(model, initial, h, false);
     case Kind::OdeQuick: return aloft::compare::make_ode(model, initial, h, true);
   }
@@ -270,8 +274,7 @@ SpanRun run_span(Kind kind, const Model& model, const State& initial, long long 
                  const std::string& label) {
   SpanRun r;
   try {
-    auto engine = kind == Kind::Aloft ? aloft::compare::make_aloft(model, initial, model.timestep, collisions)
-                                      : aloft::compare::make_bullet(model, initial, model.timestep, collisions);
+    auto engine = make(kind, model, initial, model.timestep, collisions);
     State s = initial;
     engine->read(s);
     const double kinetic0 = aloft::kinetic_energy(model, s);
@@ -303,8 +306,8 @@ SpanRun run_span(Kind kind, const Model& model, const State& initial, long long 
 // the motion is chaotic, so the seeds, not repetitions, are what to vary).
 void collision_cost(const Model& model, const std::string& label, int seed, long long steps) {
   const State initial = aloft::bench::swinging_state(model, 0.5, static_cast<std::uint64_t>(seed));
+  const std::string run = label + " seed " + std::to_string(seed);
   for (Kind kind : {Kind::Aloft, Kind::Bullet}) {
-    const std::string run = label + " seed " + std::to_string(seed);
     const SpanRun off = run_span(kind, model, initial, steps, false, run);
     const SpanRun on = run_span(kind, model, initial, steps, true, run);
     std::printf("| %s | %d | %d | %s | %lld |", label.c_str(), model.count, seed, kind_name(kind), steps);
