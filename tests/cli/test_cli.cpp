@@ -295,5 +295,35 @@ TEST_F(Cli, BenchRuns) {
   EXPECT_NE(r.out.find("skipped"), std::string::npos);
 }
 
+// The counts on a generated mobile's line of `aloft bench` (halvings and tree solves per step with
+// collisions off, halvings with them on): words 7, 8 and 12 of the line's 14 (from 0; the name is 3 words,
+// the bar one).
+std::vector<std::string> bench_counts(const std::string& out) {
+  std::istringstream lines(out);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("generated (seed 1)", 0) != 0) continue;
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    if (w.size() == 14) return {w[7], w[8], w[12]};
+  }
+  return {};
+}
+
+// The breeze that sets each mobile swinging is a number of steps, not a time (it was "up to 0.3 s" of
+// CPU time, so a slower or busier machine timed another motion), and both columns start from its end:
+// the step counts, which follow the motion alone, are the same from run to run.
+TEST_F(Cli, BenchTimesTheSameMotionEveryRun) {
+  const std::string args = "bench --sizes 15 --steps 40 --presets no-such-dir";
+  const Result first = aloft(args), second = aloft(args);
+  ASSERT_EQ(first.code, 0) << first.err;
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_NE(first.out.find("both columns from the same start, 300 steps of"), std::string::npos) << first.out;
+  const std::vector<std::string> counts = bench_counts(first.out);
+  ASSERT_EQ(counts.size(), 3u) << first.out;
+  EXPECT_EQ(counts, bench_counts(second.out)) << first.out << second.out;
+}
+
 }  // namespace
 }  // namespace aloft
