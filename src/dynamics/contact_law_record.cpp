@@ -2,6 +2,8 @@
 
 #include "aloft/contact_law_record.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -19,10 +21,32 @@ namespace {
 constexpr char kMagic[8] = {'A', 'L', 'O', 'F', 'T', 'L', 'A', 'W'};
 constexpr std::uint32_t kVersion = 1;
 
-void put_u32(std::ostream& out, std::uint32_t value) { out.write(reinterpret_cast<const char*>(&value), 4); }
+// The file is little-endian on every host (the format's byte order, aloft/contact_law_record.hpp):
+// little-endian hosts copy the bytes as they are, others reverse each value's.
+constexpr bool kHostIsLittleEndian = std::endian::native == std::endian::little;
+static_assert(kHostIsLittleEndian || std::endian::native == std::endian::big, "mixed-endian hosts are not supported");
+
+// Reverses the bytes of each of `count` values of `size` bytes at `data` (in place).
+void reverse_each(unsigned char* data, std::size_t count, std::size_t size) {
+  for (std::size_t k = 0; k < count; ++k) std::reverse(data + k * size, data + (k + 1) * size);
+}
+
+void put_u32(std::ostream& out, std::uint32_t value) {
+  unsigned char bytes[4];
+  for (int k = 0; k < 4; ++k) bytes[k] = static_cast<unsigned char>(value >> (8 * k));
+  out.write(reinterpret_cast<const char*>(bytes), 4);
+}
 
 void put_doubles(std::ostream& out, const double* values, Eigen::Index count) {
-  out.write(reinterpret_cast<const char*>(values), static_cast<std::streamsize>(count * 8));
+  const auto size = static_cast<std::streamsize>(count * 8);
+  if constexpr (kHostIsLittleEndian) {
+    out.write(reinterpret_cast<const char*>(values), size);
+  } else {
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    std::memcpy(bytes.data(), values, bytes.size());
+    reverse_each(bytes.data(), static_cast<std::size_t>(count), 8);
+    out.write(reinterpret_cast<const char*>(bytes.data()), size);
+  }
 }
 
 class RecordParser {
@@ -48,8 +72,8 @@ class RecordParser {
 
   std::uint32_t u32(const char* what) {
     if (bytes_.size() - at_ < 4) fail(at_, std::string("the file ends inside ") + what);
-    std::uint32_t value;
-    std::memcpy(&value, bytes_.data() + at_, 4);
+    std::uint32_t value = 0;
+    for (int k = 0; k < 4; ++k) value |= static_cast<std::uint32_t>(bytes_[at_ + k]) << (8 * k);
     at_ += 4;
     return value;
   }
@@ -61,6 +85,8 @@ class RecordParser {
     if (bytes_.size() - at_ < size) fail(at_, "the file ends inside " + what);
     out.resize(rows, cols);
     std::memcpy(out.data(), bytes_.data() + at_, size);
+    if constexpr (!kHostIsLittleEndian)
+      reverse_each(reinterpret_cast<unsigned char*>(out.data()), static_cast<std::size_t>(rows * cols), 8);
     for (Eigen::Index k = 0; k < rows * cols; ++k)
       if (!std::isfinite(out.data()[k])) fail(at_ + static_cast<std::size_t>(k) * 8, what + " holds a value that is not finite");
     at_ += size;

@@ -80,6 +80,44 @@ TEST(ContactLawRecord, WhatIsWrittenIsReadBackBitForBit) {
   }
 }
 
+// The format's byte order is little-endian whatever the host's, so a recording (tests/data holds one)
+// reads the same everywhere: a one-contact record's counts and numbers, byte by byte both ways. 1.0 and
+// 0.5 are IEEE 754 binary64 0x3FF0000000000000 and 0x3FE0000000000000, least significant byte first.
+TEST(ContactLawRecord, TheFileIsLittleEndianOnEveryHost) {
+  ContactLawRecord one;
+  one.K = Eigen::Matrix3d::Identity();
+  one.u = Eigen::Vector3d(-0.5, 0, 0);
+  one.target_normal = Eigen::VectorXd::Zero(1);
+  one.friction = Eigen::VectorXd::Constant(1, 0.5);
+  one.impulses = Eigen::Vector3d(0.5, 0, 0);
+  const std::string bytes = written({one});
+  const auto little_endian_double = [](std::uint64_t bits) {
+    std::string b;
+    for (int k = 0; k < 8; ++k) b += static_cast<char>((bits >> (8 * k)) & 0xff);
+    return b;
+  };
+  const std::string one_le = little_endian_double(0x3FF0000000000000ull);
+  const std::string half_le = little_endian_double(0x3FE0000000000000ull);
+  const std::string minus_half_le = little_endian_double(0xBFE0000000000000ull);
+  const std::string zero_le(8, '\0');
+  std::string expected = std::string("ALOFTLAW") + std::string("\x01\0\0\0", 4);  // version 1
+  expected += std::string("\x01\0\0\0", 4) + std::string("\0\0\0\0", 4);            // m = 1, no start
+  for (int column = 0; column < 3; ++column)
+    for (int row = 0; row < 3; ++row) expected += row == column ? one_le : zero_le;    // K, column-major
+  expected += minus_half_le + zero_le + zero_le;                                      // u
+  expected += zero_le;                                                                // target_normal
+  expected += half_le;                                                                // friction
+  expected += half_le + zero_le + zero_le;                                            // impulses
+  EXPECT_EQ(bytes, expected);
+
+  const std::vector<ContactLawRecord> read = parse_contact_law_records(bytes_of(expected), "one.law");
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_EQ(read[0].K, one.K);
+  EXPECT_EQ(read[0].u, one.u);
+  EXPECT_EQ(read[0].friction, one.friction);
+  EXPECT_EQ(read[0].impulses, one.impulses);
+}
+
 // The recorder sees every solve of the steps (those that start from the last step's impulses, and the
 // contact passes' corrections, which start from zero), and each, solved again, gives the impulses the
 // step took from it: the record is the law's whole input. Recording leaves the motion as it was.
