@@ -7,7 +7,7 @@
 // changed at all.
 //
 // File format (version 1), little-endian on every host (every double is IEEE 754 binary64; files written
-// before 2026-12-07 were in the writer's byte order, which on x86-64 and ARM64 is this one):
+// before 2026-12-07 were in the writer's byte order, the same on x86-64 and little-endian ARM):
 //   header: the 8 bytes "ALOFTLAW", then uint32 version = 1
 //   records until the end of the file, each:
 //     uint32 m (contacts, 1 ... kMaxRecordedContacts), uint32 has_start (0 or 1),
