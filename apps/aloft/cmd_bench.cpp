@@ -58,6 +58,10 @@ struct Measurement {
   std::string failure;  // non-empty if the simulation failed
 };
 
+std::string failure_of(const Simulation& sim) {
+  return sim.failure() ? sim.failure()->message : std::string("the simulation failed");
+}
+
 // Steps of the breeze that sets a mobile swinging before it is timed: 0.3 s at the default 1 ms step.
 // A count, not a time, so that every machine times the same motion.
 constexpr int kBreezeSteps = 300;
@@ -79,7 +83,7 @@ std::optional<State> swinging_start(const Model& model, const std::string& name,
   const double started = thread_seconds();
   for (int s = 0; s < kBreezeSteps; ++s) {
     if (!sim.step()) {
-      failure = "in the breeze: " + (sim.failure() ? sim.failure()->message : std::string("the simulation failed"));
+      failure = "in the breeze: " + failure_of(sim);
       return std::nullopt;
     }
     if (show_progress && s % 10 == 9 && seconds_since(started) > 1)
@@ -94,34 +98,35 @@ Measurement measure(const Model& model, const State& start, long long fixed_step
   Measurement out;
   Simulation sim(model, start);
   sim.set_collisions(collisions);
-  // Steps per repetition: enough for 0.5 s at the rate of a few calibration steps (re-measured below if
-  // the first repetition is much shorter).
-  const double calibration_start = thread_seconds();
-  constexpr long long kCalibrationSteps = 3;
-  for (long long s = 0; s < kCalibrationSteps && fixed_steps <= 0; ++s) {
-    if (!sim.step()) {
-      out.failure = sim.failure() ? sim.failure()->message : "the simulation failed";
-      return out;
+  out.steps_per_repetition = fixed_steps;
+  if (fixed_steps <= 0) {
+    // Enough steps for 0.5 s at the rate of a few calibration steps (re-measured below if the first
+    // repetition is much shorter).
+    constexpr long long kCalibrationSteps = 3;
+    const double calibration_start = thread_seconds();
+    for (long long s = 0; s < kCalibrationSteps; ++s) {
+      if (!sim.step()) {
+        out.failure = failure_of(sim);
+        return out;
+      }
     }
+    const double rate = static_cast<double>(kCalibrationSteps) / std::max(seconds_since(calibration_start), 1e-9);
+    out.steps_per_repetition = std::max(3LL, static_cast<long long>(std::ceil(0.5 * rate)));
   }
-  const double calibration_rate =
-      static_cast<double>(kCalibrationSteps) / std::max(seconds_since(calibration_start), 1e-9);
-  out.steps_per_repetition =
-      fixed_steps > 0 ? fixed_steps : std::max(3LL, static_cast<long long>(std::ceil(0.5 * calibration_rate)));
 
   std::vector<double> rates;
   const long long subdivisions_before = sim.subdivisions();
   const long long iterations_before = sim.joint_iterations();
   const long long steps_before = sim.step_count();
   for (int r = 0; r < kRepetitions; ++r) {
-    const double start = thread_seconds();
+    const double repetition_start = thread_seconds();
     for (long long s = 0; s < out.steps_per_repetition; ++s) {
       if (!sim.step()) {
-        out.failure = sim.failure() ? sim.failure()->message : "the simulation failed";
+        out.failure = failure_of(sim);
         return out;
       }
     }
-    const double elapsed = std::max(seconds_since(start), 1e-9);
+    const double elapsed = std::max(seconds_since(repetition_start), 1e-9);
     rates.push_back(static_cast<double>(out.steps_per_repetition) / elapsed);
     // Keep a too-short calibration from making the repetitions short: re-measure at >= 0.5 s.
     if (r == 0 && fixed_steps <= 0 && elapsed < 0.4) {
