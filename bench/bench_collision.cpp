@@ -1,7 +1,8 @@
 // Collision detection cost: CollisionDetector::find_contacts on the Steel Fish and on generated mobiles
 // of 127, 1023 and 8191 components, at rest (the designed pose, still) and slightly displaced (every
 // joint turned by a random angle of up to `kTurn` about a random axis, composed down the tree, with the
-// swinging velocities of bench_models.hpp so the speculative margins are those of a moving mobile).
+// velocities of swinging_state (aloft/state.hpp), so that the speculative margins are those of a moving
+// mobile).
 // Reports time per call and, as the counter "per_component", per component. Margin: 1 mm + step * speed.
 //
 //   build/<dir>/bench/aloft_bench_collision --benchmark_repetitions=5 --benchmark_report_aggregates_only
@@ -31,7 +32,7 @@ State displaced_state(const Model& model, double max_turn, std::uint64_t seed = 
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
   };
-  State state = bench::swinging_state(model);
+  State state = swinging_state(model);
   std::vector<Quat> turn(model.count, Quat::Identity());
   for (int i = 1; i < model.count; ++i) {
     const Vec3 axis = Vec3(2 * unit() - 1, 2 * unit() - 1, 2 * unit() - 1).normalized();

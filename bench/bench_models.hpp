@@ -1,9 +1,7 @@
 #pragma once
-// The mobiles the benchmarks run (presets from mobiles/, generated ones) and the common initial state:
-// the designed pose with every component turning, so that the mobile swings.
+// The mobiles the benchmarks run (presets from mobiles/, generated ones) and how long BM_StepSpan runs
+// them. Their common start is the library's swinging_state (aloft/state.hpp).
 
-#include <cmath>
-#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -49,36 +47,6 @@ inline int span_steps(int components) {
   if (components <= 1023) return 5000;
   if (components <= 8191) return 2000;
   return 30;
-}
-
-// The designed pose with a random angular velocity (world, uniform direction, magnitude uniform in
-// [rate/2, rate] rad/s) on every moving component, and centre-of-mass velocities that keep every joint
-// together: v_i = v_p + w_p x (j_i - x_p) + w_i x (x_i - j_i). Same seed, same state on every machine
-// (a fixed 64-bit generator, no <random> distributions).
-inline State swinging_state(const Model& model, double rate = 0.5, std::uint64_t seed = 7) {
-  std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 1;
-  auto unit = [&s] {  // splitmix64 -> [0, 1)
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-53;
-  };
-  State state = rest_state(model);
-  for (int i = 1; i < model.count; ++i) {
-    const double z = 2 * unit() - 1;
-    const double phi = 2 * M_PI * unit();
-    const double r = std::sqrt(std::max(0.0, 1 - z * z));
-    const Vec3 axis(r * std::cos(phi), r * std::sin(phi), z);
-    state.angular[i] = rate * (0.5 + 0.5 * unit()) * axis;
-  }
-  for (int i = 1; i < model.count; ++i) {
-    const int p = model.parent[i];
-    const Vec3 joint = joint_on_child(model, state, i);
-    state.velocity[i] = state.velocity[p] + state.angular[p].cross(joint - state.position[p]) +
-                        state.angular[i].cross(state.position[i] - joint);
-  }
-  return state;
 }
 
 }  // namespace aloft::bench

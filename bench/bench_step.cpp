@@ -1,6 +1,6 @@
 // aloft_bench: the cost of a simulation step, and of the tree solver's factor and solve alone.
 //
-//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (bench_models.hpp), collisions off
+//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (aloft/state.hpp: swinging_state), collisions off
 //                        (issue 2's figure): presets from mobiles/ and generated mobiles of 15 ... 65535
 //                        components
 //   BM_StepCollisions/<mobile>  the same with collisions on (issue 3's figure)
@@ -16,7 +16,7 @@
 //
 // items_per_second is steps (or factorizations, solves) per second of CPU time; us_per_component_step is
 // the CPU time per moving component (count - 1) and per step, in microseconds. The mobiles start swinging
-// (bench_models.hpp: swinging_state), so that the joint iterations do real work. The step benchmarks also
+// (aloft/state.hpp: swinging_state), so that the joint iterations do real work. The step benchmarks also
 // count halvings and tree solves per step and, with collisions on, the contact law's solves per step
 // (law_solves) and the contacts per solve (law_contacts: its sweeps and collision matrix cost O(m^2) in
 // them), as aloft_step_profile does.
@@ -95,12 +95,12 @@ const Model* model_or_skip(benchmark::State& state, const std::string& key) {
   return entry.model.get();
 }
 
-// Steps the mobile from the swinging state drawn with `seed` (bench_models.hpp: swinging_state).
+// Steps the mobile from the swinging state drawn with `seed` (aloft/state.hpp: swinging_state).
 void BM_Step(benchmark::State& state, const std::string& key, bool collisions, std::uint64_t seed) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
   const Model& model = *found;
-  aloft::Simulation sim(model, aloft::bench::swinging_state(model, 0.5, seed));
+  aloft::Simulation sim(model, aloft::swinging_state(model, 0.5, seed));
   sim.set_collisions(collisions);
   const double start = aloft::thread_seconds();
   for (auto _ : state) {
@@ -132,7 +132,7 @@ void BM_Factor(benchmark::State& state, const std::string& key) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
   const Model& model = *found;
-  const aloft::State pose = aloft::bench::swinging_state(model);
+  const aloft::State pose = aloft::swinging_state(model);
   aloft::TreeSolver solver(model);
   const double start = aloft::thread_seconds();
   for (auto _ : state) {
@@ -146,7 +146,7 @@ void BM_Solve(benchmark::State& state, const std::string& key) {
   const Model* found = model_or_skip(state, key);
   if (!found) return;
   const Model& model = *found;
-  const aloft::State pose = aloft::bench::swinging_state(model);
+  const aloft::State pose = aloft::swinging_state(model);
   aloft::TreeSolver solver(model);
   solver.factor(pose);
   // Right-hand side: gravity on every body, a small gap at every joint.

@@ -1,7 +1,7 @@
 // aloft_step_profile: a fixed, repeatable stepping run for profilers (valgrind --tool=callgrind counts
 // instructions deterministically, so two builds can be compared on a busy machine) and a quick CPU-time
 // figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), or
-// starts from the benchmarks' swinging state (bench_models.hpp, as BM_Step and BM_StepSpan do; one
+// starts from the benchmarks' swinging state (aloft/state.hpp: swinging_state, as BM_Step and BM_StepSpan do; one
 // step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
 // the function to give callgrind's --toggle-collect.
 //
@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
   const std::string start = argc > 4 ? argv[4] : "breeze";
   const std::size_t colon = start.find(':');
   const std::string start_from = start.substr(0, colon);
-  unsigned long seed = 7;  // bench::swinging_state's default
+  unsigned long seed = 7;  // swinging_state's default
   bool seed_ok = true;
   if (colon != std::string::npos) {
     const std::string digits = start.substr(colon + 1);
@@ -177,7 +177,7 @@ int main(int argc, char** argv) {
     } else {
       model = std::move(*bench::generated_model(std::atoi(what.c_str())));  // seed 1
     }
-    Simulation sim(model, swinging ? bench::swinging_state(model, 0.5, seed) : rest_state(model));
+    Simulation sim(model, swinging ? swinging_state(model, 0.5, seed) : rest_state(model));
     sim.set_collisions(collisions);
     if (swinging) {
       if (!sim.step()) throw std::runtime_error(sim.failure()->message);

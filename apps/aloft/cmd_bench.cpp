@@ -1,14 +1,19 @@
 // aloft bench: simulation speed (steps per second) on the preset mobiles and on generated mobiles of
 // growing size, without collisions (issue 2's figure) and with them (issue 3's), in the same run. Each
-// mobile is set swinging once, by a breeze (0.2 g for 300 steps, collisions on), and both figures are
-// timed from that same state, each over 5 repetitions of enough steps for at least 0.5 s (or --steps);
-// the median is reported. One start for both, as in BM_StepSpan, and a start that does not depend on
-// the machine (each column used to get a breeze of its own, cut short after 0.3 s of CPU time). The two
-// runs still part from there: without collisions the pieces pass through each other and keep the energy
-// the knocks would take (the footer below says so to the user).
+// mobile is set swinging once, by a breeze (0.2 g for 300 steps, collisions on) or, with --start
+// swinging[:SEED], by the benchmarks' swinging state (aloft/state.hpp: swinging_state), and both figures
+// are timed from that same state, each over 5 repetitions (--repetitions) of enough steps for at least
+// 0.5 s (or --steps); the median is reported. One start for both, as in BM_StepSpan, and a start that
+// does not depend on the machine (each column used to get a breeze of its own, cut short after 0.3 s of
+// CPU time). The two runs still part from there: without collisions the pieces pass through each other
+// and keep the energy the knocks would take (the footer below says so to the user). With --start
+// swinging:SEED --repetitions 1 --steps N the collisions-on over collisions-off ratio is issue 3's
+// measure, BM_StepSpan's, for that start and span.
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +26,7 @@
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
+#include "aloft/state.hpp"
 #include "aloft/thread_clock.hpp"
 #include "common.hpp"
 
@@ -66,12 +72,37 @@ std::string failure_of(const Simulation& sim) {
 // A count, not a time, so that every machine times the same motion.
 constexpr int kBreezeSteps = 300;
 
+// Where both timed runs of a mobile start (--start): after the breeze (the default), or from the
+// benchmarks' swinging state of `seed` (swinging_state, max rate 0.5 rad/s, as BM_StepSpan).
+struct BenchStart {
+  bool swinging = false;
+  std::uint64_t seed = 7;  // swinging_state's default, BM_StepSpan's start
+
+  std::string describe() const {
+    return swinging ? format("the swinging state of seed %llu (as BM_StepSpan)", static_cast<unsigned long long>(seed))
+                    : format("%d steps of a breeze with collisions on", kBreezeSteps);
+  }
+};
+
+// "breeze", "swinging" or "swinging:SEED" (SEED a whole number); empty if the text is none of these.
+std::optional<BenchStart> parse_start(const std::string& text) {
+  if (text == "breeze") return BenchStart{};
+  if (text == "swinging") return BenchStart{true};
+  const std::string prefix = "swinging:";
+  if (text.rfind(prefix, 0) != 0 || text.size() == prefix.size()) return std::nullopt;
+  BenchStart start{true};
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data() + prefix.size(), end, start.seed);
+  if (ec != std::errc() || ptr != end) return std::nullopt;
+  return start;
+}
+
 // The state both timed runs of a mobile start from: the designed pose at rest, pushed for kBreezeSteps
 // steps by a horizontal 0.2 g on every component (its direction turning by the golden angle from one
 // component to the next), with collisions on, as the mobile would move in a room's draught (a balanced
 // mobile at rest would be an unrepresentatively easy case). Empty, with `failure` set, if the
 // simulation failed. Shows its progress on a terminal: the largest mobiles take seconds.
-std::optional<State> swinging_start(const Model& model, const std::string& name, std::string& failure) {
+std::optional<State> breeze_start(const Model& model, const std::string& name, std::string& failure) {
   Simulation sim(model);
   sim.set_collisions(true);
   sim.loads().resize(model.count);
@@ -93,8 +124,15 @@ std::optional<State> swinging_start(const Model& model, const std::string& name,
   return sim.state();
 }
 
-Measurement measure(const Model& model, const State& start, long long fixed_steps, bool collisions) {
-  constexpr int kRepetitions = 5;
+// The timing both ways: `repetitions` runs of `fixed_steps` steps each (or, if it is 0, enough for 0.5 s),
+// one after another from the start; the median rate is reported.
+struct Timing {
+  long long fixed_steps = 0;
+  int repetitions = 5;
+};
+
+Measurement measure(const Model& model, const State& start, const Timing& timing, bool collisions) {
+  const long long fixed_steps = timing.fixed_steps;
   Measurement out;
   Simulation sim(model, start);
   sim.set_collisions(collisions);
@@ -118,7 +156,7 @@ Measurement measure(const Model& model, const State& start, long long fixed_step
   const long long subdivisions_before = sim.subdivisions();
   const long long iterations_before = sim.joint_iterations();
   const long long steps_before = sim.step_count();
-  for (int r = 0; r < kRepetitions; ++r) {
+  for (int r = 0; r < timing.repetitions; ++r) {
     const double repetition_start = thread_seconds();
     for (long long s = 0; s < out.steps_per_repetition; ++s) {
       if (!sim.step()) {
@@ -136,7 +174,8 @@ Measurement measure(const Model& model, const State& start, long long fixed_step
     }
   }
   std::sort(rates.begin(), rates.end());
-  out.steps_per_second = rates[rates.size() / 2];
+  const std::size_t middle = rates.size() / 2;
+  out.steps_per_second = rates.size() % 2 == 1 ? rates[middle] : 0.5 * (rates[middle - 1] + rates[middle]);
   const double steps = static_cast<double>(std::max(1LL, sim.step_count() - steps_before));
   const double subdivided = static_cast<double>(sim.subdivisions() - subdivisions_before);
   out.subdivided = subdivided / steps;
@@ -165,15 +204,16 @@ void print_row(const std::string& name, int components, const Measurement& free,
 }
 
 // Sets the mobile swinging, times it both ways from there and prints its line.
-void bench_mobile(const Model& model, const std::string& name, long long fixed_steps) {
+void bench_mobile(const Model& model, const std::string& name, const BenchStart& how, const Timing& timing) {
   std::string failure;
-  const std::optional<State> start = swinging_start(model, name, failure);
+  const std::optional<State> start =
+      how.swinging ? std::optional<State>(swinging_state(model, 0.5, how.seed)) : breeze_start(model, name, failure);
   if (!start) {
     std::printf("%-20s %6d  failed: %s\n", name.c_str(), model.count, failure.c_str());
     std::fflush(stdout);
     return;
   }
-  print_row(name, model.count, measure(model, *start, fixed_steps, false), measure(model, *start, fixed_steps, true));
+  print_row(name, model.count, measure(model, *start, timing, false), measure(model, *start, timing, true));
 }
 
 }  // namespace
@@ -181,8 +221,10 @@ void bench_mobile(const Model& model, const std::string& name, long long fixed_s
 Runner add_bench(CLI::App& app) {
   struct Options {
     long long steps = 0;
+    int repetitions = 5;
     std::vector<int> sizes{15, 127, 1023, 8191, 65535};
     std::string presets;
+    std::string start = "breeze";
   };
   auto o = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -191,6 +233,20 @@ Runner add_bench(CLI::App& app) {
   sub->add_option("--steps", o->steps, "Steps per repetition (>= 1; default: enough for 0.5 s)")
       ->type_name("N")
       ->check(integer_in(1, 1000000000));
+  sub->add_option("--repetitions", o->repetitions, "Timed runs per figure, one after another; the median is reported (default 5)")
+      ->type_name("R")
+      ->check(integer_in(1, 1000));
+  sub->add_option("--start", o->start,
+                  "Where both runs start: 'breeze' (default: 300 steps of a 0.2 g breeze, collisions on), or "
+                  "'swinging' / 'swinging:SEED' (the benchmarks' swinging state; seed 7 if not given)")
+      ->type_name("FROM")
+      ->check(CLI::Validator(
+          [](std::string& input) -> std::string {
+            return parse_start(input) ? std::string()
+                                      : "must be 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole number), got \"" +
+                                            input + "\"";
+          },
+          ""));
   sub->add_option("--sizes", o->sizes, "Sizes (components, hook included) of the generated mobiles, comma-separated (each >= 2; default 15,127,1023,8191,65535)")
       ->type_name("N,...")
       ->delimiter(',')
@@ -201,28 +257,35 @@ Runner add_bench(CLI::App& app) {
       "Prints steps per second, microseconds per step and per moving component per step for the preset\n"
       "mobiles (steel-fish.json and southern-cross.json; a missing one is skipped with a note) and for\n"
       "generated mobiles (seed 1), first with collisions off, then (right of the bar) with collisions on.\n"
-      "Each mobile is set swinging once, by a breeze (0.2 g for 300 steps, collisions on); both are timed\n"
-      "(thread CPU time) from that same state, over 5 repetitions of at least 0.5 s (or --steps steps),\n"
-      "and the median is reported. \"halv\" counts how often per step the step had to be halved because\n"
-      "something spun too fast for it; \"solves\" the tree solves per step (joint corrections and velocity\n"
-      "projections); \"ratio\" the time per step with collisions over without.\n"
+      "Each mobile is set swinging once, by a breeze (0.2 g for 300 steps, collisions on) or, with\n"
+      "--start swinging[:SEED], from the benchmarks' swinging state (every component turning at 0.25-0.5\n"
+      "rad/s in a random direction drawn from SEED, 7 if not given). Both are timed (thread CPU time) from\n"
+      "that same state, over 5 repetitions (--repetitions) of at least 0.5 s (or --steps steps) one after\n"
+      "another, and the median is reported. \"halv\" counts how often per step the step had to be halved\n"
+      "because something spun too fast for it; \"solves\" the tree solves per step (joint corrections and\n"
+      "velocity projections); \"ratio\" the time per step with collisions over without.\n"
       "The two columns start from the same state but do not stay in the same motion: without collisions\n"
-      "pieces pass through each other and keep the energy knocks would take, so light bars spin and halve\n"
-      "the step (compare \"halv\"). Issue 3's target is measured on a calmer start by the benchmarks'\n"
-      "BM_StepSpan (docs/performance.md).\n"
+      "pieces pass through each other and keep the energy knocks would take. After the breeze light bars\n"
+      "then spin and halve the step (compare \"halv\"), so the default start's ratio is not issue 3's\n"
+      "measure. That is the benchmarks' BM_StepSpan: one span from the swinging state, timed whole, e.g.\n"
+      "5000 steps at 1023 components (docs/performance.md); --start swinging:SEED --repetitions 1\n"
+      "--steps N gives it for one start.\n"
       "\n"
       "Examples:\n"
       "  aloft bench\n"
       "  aloft bench --sizes 15,127 --steps 2000\n"
-      "  aloft bench --presets ~/aloft/mobiles --sizes 1023\n");
+      "  aloft bench --presets ~/aloft/mobiles --sizes 1023\n"
+      "  aloft bench --sizes 1023 --start swinging:1 --repetitions 1 --steps 5000   # issue 3's measure\n");
   return [o] {
     namespace fs = std::filesystem;
+    const BenchStart start = *parse_start(o->start);  // checked by the option's validator
+    const Timing timing{o->steps, o->repetitions};
     const std::string dir = o->presets.empty() ? (fs::path(source_dir()) / "mobiles").string() : o->presets;
     std::printf("aloft bench: %s, %u cores; build %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
                 ALOFT_BUILD_TYPE);
-    std::printf("thread CPU time, median of 5 repetitions of %s; both columns from the same start, %d steps of\n"
-                "a breeze with collisions on\n\n",
-                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", kBreezeSteps);
+    std::printf("thread CPU time, median of %d repetition%s of %s; both columns from the same start,\n%s\n\n",
+                timing.repetitions, timing.repetitions == 1 ? "" : "s",
+                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", start.describe().c_str());
     std::printf("%-27s %-46s | %s\n", "", "collisions off (issue 2)", "collisions on (issue 3)");
     std::printf("%-20s %6s %11s %10s %8s %6s %6s | %10s %8s %6s %6s\n", "mobile", "comps", "steps/s", "us/step",
                 "us/comp", "halv", "solves", "us/step", "us/comp", "halv", "ratio");
@@ -236,7 +299,7 @@ Runner add_bench(CLI::App& app) {
         continue;
       }
       try {
-        bench_mobile(load_mobile(path.string()), preset, o->steps);
+        bench_mobile(load_mobile(path.string()), preset, start, timing);
       } catch (const std::exception& e) {
         notes.push_back(std::string(preset) + " skipped: " + e.what());
       }
@@ -246,7 +309,7 @@ Runner add_bench(CLI::App& app) {
       g.components = n;
       g.seed = 1;
       bench_mobile(compile(parse_mobile_text(generate_mobile(g), format("generated-%d.json", n))),
-                   "generated (seed 1)", o->steps);
+                   "generated (seed 1)", start, timing);
     }
     if (!notes.empty()) {
       std::printf("\n");

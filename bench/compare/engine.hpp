@@ -1,6 +1,6 @@
 #pragma once
 // One simulator behind a common face, for aloft_compare: built from an Aloft Model and an initial State
-// at the model's designed pose (bench_models.hpp: swinging_state), stepped at a fixed timestep with no
+// at the model's designed pose (aloft/state.hpp: swinging_state), stepped at a fixed timestep with no
 // damping, and read back as an Aloft State (centres of mass, body = principal frames) so that energies
 // and joint separations are measured by the same code for every engine. Aloft and Bullet can also be
 // built with collisions (aloft_compare --collisions): the cost of the same span with and without them.

@@ -1,7 +1,7 @@
 // aloft_compare: Aloft against Bullet (btMultiBody, Featherstone) and ODE (dWorldStep, dWorldQuickStep)
 // on the same mobiles, in one process.
 //
-//   1. Trajectories: every engine starts from the same swinging state (bench_models.hpp) of the Steel
+//   1. Trajectories: every engine starts from the same swinging state (aloft/state.hpp) of the Steel
 //      Fish (or a generated 15-component mobile); the largest distance over components between the
 //      centres of mass of Aloft and each other engine at t = 0.1, 0.5, 1 s, at h = 1 ms and 0.1 ms, and
 //      every engine's distance to Aloft at h = 0.01 ms (its own discretization error).
@@ -53,7 +53,7 @@ struct Options {
   bool table = true;
   bool collisions = false;                       // section 3
   std::vector<int> collision_sizes = {127, 1023};
-  std::vector<int> collision_seeds = {7};        // of the swinging state (bench_models.hpp)
+  std::vector<int> collision_seeds = {7};        // of the swinging state (aloft/state.hpp)
   long long collision_steps = 0;                 // 0: BM_StepSpan's span for the size
   double bullet_contact_threshold = -1;          // gContactBreakingThreshold; < 0: Bullet's default
 };
@@ -113,7 +113,7 @@ std::vector<State> sample_trajectory(Kind kind, const Model& model, const State&
 }
 
 void trajectories(const Model& model, const std::string& label) {
-  const State initial = aloft::bench::swinging_state(model);
+  const State initial = aloft::swinging_state(model);
   const std::vector<double> times = {0.1, 0.5, 1.0};
   const std::vector<Kind> kinds = {Kind::Aloft, Kind::Bullet, Kind::OdeStep, Kind::OdeQuick};
   std::printf("\n## Trajectories: %s (%d components), from the swinging state\n", label.c_str(), model.count);
@@ -185,7 +185,7 @@ struct Row {
 
 // One table row per engine (printed as it is done); returns a note for below the table.
 std::string cost_and_accuracy(const Model& model, const std::string& label, const Options& options) {
-  const State initial = aloft::bench::swinging_state(model);
+  const State initial = aloft::swinging_state(model);
   std::vector<Row> rows;
   for (Kind k : {Kind::Aloft, Kind::Bullet, Kind::OdeStep, Kind::OdeQuick}) {
     Row r;
@@ -307,7 +307,7 @@ SpanRun run_span(Kind kind, const Model& model, const State& initial, long long 
 // One row per engine: off, then on, one run each (a span is seconds to minutes, and with collisions
 // the motion is chaotic, so the seeds, not repetitions, are what to vary).
 void collision_cost(const Model& model, const std::string& label, int seed, long long steps) {
-  const State initial = aloft::bench::swinging_state(model, 0.5, static_cast<std::uint64_t>(seed));
+  const State initial = aloft::swinging_state(model, 0.5, static_cast<std::uint64_t>(seed));
   const std::string run = label + " seed " + std::to_string(seed);
   for (Kind kind : {Kind::Aloft, Kind::Bullet}) {
     const SpanRun off = run_span(kind, model, initial, steps, false, run);

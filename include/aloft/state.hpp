@@ -2,6 +2,7 @@
 // The mutable simulation state: positions and velocities of every component. Kept apart from the
 // immutable Model; index 0 (the fixed component) never moves.
 
+#include <cstdint>
 #include <vector>
 
 #include "aloft/model.hpp"
@@ -18,6 +19,14 @@ struct State {
 
 // The designed pose, at rest.
 State rest_state(const Model& model);
+
+// The designed pose set swinging: every moving component turning at a random angular velocity (world,
+// uniform direction, magnitude uniform in [max_rate / 2, max_rate] rad/s), with centre-of-mass
+// velocities that keep every joint together, v_i = v_p + w_p x (j_i - x_p) + w_i x (x_i - j_i). The
+// benchmarks' start (BM_StepSpan, aloft_step_profile, `aloft bench --start swinging:SEED`). The same
+// seed gives the same state on every machine: a fixed 64-bit generator (splitmix64), no <random>
+// distributions.
+State swinging_state(const Model& model, double max_rate = 0.5, std::uint64_t seed = 7);
 
 // Energy (J) of a state: kinetic + gravitational potential (zero at the world origin).
 double kinetic_energy(const Model& model, const State& state);

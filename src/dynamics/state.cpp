@@ -1,6 +1,7 @@
 #include "aloft/state.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace aloft {
 
@@ -12,6 +13,32 @@ State rest_state(const Model& model) {
   s.velocity.assign(model.count, Vec3::Zero());
   s.angular.assign(model.count, Vec3::Zero());
   return s;
+}
+
+State swinging_state(const Model& model, double max_rate, std::uint64_t seed) {
+  std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 1;
+  auto unit = [&s] {  // splitmix64 -> [0, 1)
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+  };
+  State state = rest_state(model);
+  for (int i = 1; i < model.count; ++i) {
+    const double z = 2 * unit() - 1;
+    const double phi = 2 * M_PI * unit();
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    const Vec3 axis(r * std::cos(phi), r * std::sin(phi), z);
+    state.angular[i] = max_rate * (0.5 + 0.5 * unit()) * axis;
+  }
+  for (int i = 1; i < model.count; ++i) {
+    const int p = model.parent[i];
+    const Vec3 joint = joint_on_child(model, state, i);
+    state.velocity[i] = state.velocity[p] + state.angular[p].cross(joint - state.position[p]) +
+                        state.angular[i].cross(state.position[i] - joint);
+  }
+  return state;
 }
 
 double kinetic_energy(const Model& model, const State& state) {
