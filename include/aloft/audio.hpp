@@ -15,7 +15,8 @@
 
 namespace aloft {
 
-// A decoded audio file: interleaved samples converted to float in [-1, 1].
+// A decoded audio file: interleaved samples as floats, full scale 1 (integer encodings in [-1, 1); float
+// ones as stored, which read_wav keeps within +-1000).
 struct AudioClip {
   std::string file;
   int sample_rate = 0;               // Hz
@@ -28,7 +29,8 @@ struct AudioClip {
 
 // Read a RIFF/WAVE file: PCM 8/16/24/32-bit integer or IEEE float 32/64-bit (also WAVE_FORMAT_EXTENSIBLE),
 // 1 to 8 channels. Throws InputError naming the file, the byte offset and what is wrong (not a RIFF file,
-// truncated chunk, unsupported encoding, no data chunk, ...).
+// truncated chunk, unsupported encoding, no data chunk, a float sample that is a NaN, infinite or beyond
+// +-1000, 60 dB above full scale: not sound, ...).
 AudioClip read_wav(const std::string& path);
 // The same from bytes in memory (`name` is used in messages).
 AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& name);
@@ -65,7 +67,7 @@ class EnvelopeFollower {
  private:
   int rate_;
   EnvelopeSettings settings_;
-  std::vector<float> window_;    // squares, ring buffer
+  std::vector<double> window_;   // squares of the last window's samples, ring buffer
   std::size_t head_ = 0;
   double sum_ = 0;               // sum of window_, recomputed now and then against drift
   double rms_ = 0;

@@ -64,14 +64,16 @@ void EnvelopeFollower::push(const float* mono, std::size_t count) {
 
 void EnvelopeFollower::push(float sample) {
   const std::size_t n = window_.size();
-  const float square = sample * sample;
-  sum_ += static_cast<double>(square) - window_[head_];
+  // Squared in double: the square of any finite float is finite there (at most 1.2e77), where a float
+  // square of a sample past 1.8e19 would be infinite and the running sum then NaN for good.
+  const double square = static_cast<double>(sample) * sample;
+  sum_ += square - window_[head_];
   window_[head_] = square;
   if (++head_ == n) {
     head_ = 0;
     // Once per window, re-add the window exactly so rounding in the running sum cannot build up.
     double exact = 0;
-    for (float s : window_) exact += s;
+    for (double s : window_) exact += s;
     sum_ = exact;
     if (calibrating_) calibration_levels_.push_back(static_cast<float>(std::sqrt(exact / n)));
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -18,6 +19,12 @@ namespace {
 constexpr std::uint16_t kFormatPcm = 1;
 constexpr std::uint16_t kFormatFloat = 3;
 constexpr std::uint16_t kFormatExtensible = 0xFFFE;
+
+// The largest float sample taken as sound: full scale is 1.0, and float files may go past it (a mix
+// left unclipped), but 1000 is 60 dB above it. A larger value is not a recording of a breath (a
+// damaged file, or raw numbers written as audio): one sample of 1e30 would hold the wind at its
+// strongest for many seconds, a silent wrong result.
+constexpr double kLargestFloatSample = 1000;
 
 struct Reader {
   const std::vector<std::uint8_t>& bytes;
@@ -34,22 +41,31 @@ struct Reader {
   bool tag(std::size_t at, const char* four) const { return std::memcmp(bytes.data() + at, four, 4) == 0; }
 };
 
-// One sample at `p` (little-endian) as a float in [-1, 1].
-float decode(const std::uint8_t* p, std::uint16_t format, int bits) {
-  if (format == kFormatFloat) {
-    if (bits == 32) {
-      std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                        (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-      float f;
-      std::memcpy(&f, &u, 4);
-      return f;
-    }
-    std::uint64_t u = 0;
-    for (int i = 7; i >= 0; --i) u = (u << 8) | p[i];
-    double d;
-    std::memcpy(&d, &u, 8);
-    return static_cast<float>(d);
+// A sample's value for a message: "1e+30", "-1234.5".
+std::string format_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+// One float sample at `p` (little-endian, 32 or 64 bits), as stored: any value, NaN included.
+double decode_float(const std::uint8_t* p, int bits) {
+  if (bits == 32) {
+    std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+                      (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+    float f;
+    std::memcpy(&f, &u, 4);
+    return f;
   }
+  std::uint64_t u = 0;
+  for (int i = 7; i >= 0; --i) u = (u << 8) | p[i];
+  double d;
+  std::memcpy(&d, &u, 8);
+  return d;
+}
+
+// One integer sample at `p` (little-endian) as a float in [-1, 1].
+float decode_integer(const std::uint8_t* p, int bits) {
   switch (bits) {
     case 8: return (static_cast<int>(p[0]) - 128) / 128.0f;  // unsigned, offset 128
     case 16: return static_cast<std::int16_t>(p[0] | (p[1] << 8)) / 32768.0f;
@@ -136,11 +152,20 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
       clip.sample_rate = static_cast<int>(rate);
       clip.channels = channels;
       clip.samples.resize(frames * channels);
-      const int width = bits / 8;
-      for (std::size_t i = 0; i < clip.samples.size(); ++i)
-        clip.samples[i] = decode(bytes.data() + body + i * width, format, bits);
-      for (float s : clip.samples)
-        if (!std::isfinite(s)) r.fail(body, "the float samples include a NaN or an infinity");
+      const std::size_t width = bits / 8;
+      for (std::size_t i = 0; i < clip.samples.size(); ++i) {
+        const std::size_t offset = body + i * width;
+        if (format == kFormatPcm) {
+          clip.samples[i] = decode_integer(bytes.data() + offset, bits);
+          continue;
+        }
+        const double value = decode_float(bytes.data() + offset, bits);
+        if (!std::isfinite(value)) r.fail(offset, "float sample " + std::to_string(i) + " is a NaN or an infinity");
+        if (std::abs(value) > kLargestFloatSample)
+          r.fail(offset, "float sample " + std::to_string(i) + " is " + format_number(value) +
+                             ": full scale is 1, and a sample beyond +-1000 (60 dB above it) is not sound");
+        clip.samples[i] = static_cast<float>(value);
+      }
       return clip;
     }
     at = body + size + (size & 1);  // chunks are padded to even sizes

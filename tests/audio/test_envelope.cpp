@@ -63,6 +63,39 @@ TEST(Envelope, QuietThenBurstRisesWithinFiftyMilliseconds) {
   EXPECT_GT(f.v0(), 0.5 * during);
 }
 
+// Any finite sample keeps the follower finite (a float square overflows past 1.8e19: the running sum
+// then went NaN and the envelope stayed NaN, so v0 read 0, no wind, for the rest of the recording). The
+// loudest sample read_wav lets through, 1000 (60 dB above full scale), holds the wind at its strongest
+// for a moment and then lets the breath's own v0 come back.
+TEST(Envelope, AHugeSampleNeitherStopsTheWindNorHoldsIt) {
+  EnvelopeSettings settings;
+  settings.noise_floor = 0;
+  const float breath = 0.2f;  // a square wave of RMS 0.2: v0 = 25 * 0.2 = 5 m/s once settled
+  const auto blow = [breath](EnvelopeFollower& f, int samples) {
+    for (int i = 0; i < samples; ++i) f.push(i % 2 ? breath : -breath);
+  };
+  for (const float spike : {1e30f, 1000.0f}) {
+    EnvelopeFollower f(48000, settings);
+    blow(f, 48000);
+    EXPECT_NEAR(f.v0(), 5.0, 1e-6);
+    f.push(spike);
+    blow(f, 240);  // the spike's 5 ms in the window, the attack's time constant
+    EXPECT_EQ(f.v0(), settings.max_v0) << spike;  // as loud as can be: the clamp
+    blow(f, 48000);
+    EXPECT_TRUE(std::isfinite(f.envelope())) << spike;
+    EXPECT_GE(f.v0(), 5.0 - 1e-6) << spike;  // the release only brings it down towards the breath
+  }
+  // The 1000 spike: a window RMS of 1000 / sqrt(240) = 65 for 5 ms lifts the envelope by about 40; the
+  // 150 ms release lets that go as exp(-t / 0.15 s), so after 3 s v0 is within 25 * 40 * exp(-20) =
+  // 2.1e-6 m/s of the breath's (measured 2.2e-6); 1e-5 m/s holds it with margin, where a follower stuck
+  // at the spike would read 20.
+  EnvelopeFollower f(48000, settings);
+  blow(f, 48000);
+  f.push(1000.0f);
+  blow(f, 3 * 48000);
+  EXPECT_NEAR(f.v0(), 5.0, 1e-5);
+}
+
 TEST(Envelope, GivenNoiseFloorSkipsCalibration) {
   EnvelopeSettings settings;
   settings.noise_floor = 0.05;

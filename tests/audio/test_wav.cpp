@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <random>
 
 #include "aloft/audio.hpp"
@@ -105,6 +107,41 @@ TEST(WavReader, MalformedFilesAreNamedAndExplained) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/blow.wav: cannot open the audio file"), std::string::npos) << e.what();
   }
+}
+
+// Float samples as stored, up to 1000 either way (a mix left unclipped goes past full scale, 1); a NaN,
+// an infinity or anything beyond 1000 (60 dB above full scale) is not sound, and is named with its
+// sample index and byte offset. The data chunk starts at byte 44 in these files.
+TEST(WavReader, FloatSamplesThatAreNotSoundAreNamed) {
+  const auto float32_file = [](std::vector<float> values) {
+    std::vector<std::uint8_t> data;
+    for (float f : values) {
+      std::uint32_t u;
+      std::memcpy(&u, &f, 4);
+      put32(data, u);
+    }
+    return wav_bytes(3, 1, 48000, 32, data);
+  };
+  const AudioClip loud = parse_wav(float32_file({0.5f, -1000.0f, 2.5f}), "loud.wav");
+  ASSERT_EQ(loud.samples.size(), 3u);
+  EXPECT_EQ(loud.samples[1], -1000.0f);
+  EXPECT_EQ(loud.samples[2], 2.5f);
+
+  const std::string huge = message_of(float32_file({0.5f, 0.25f, 1e30f}));
+  EXPECT_NE(huge.find("bad.wav: byte 52: float sample 2 is 1e+30: full scale is 1"), std::string::npos) << huge;
+  const std::string over = message_of(float32_file({1000.5f}));
+  EXPECT_NE(over.find("byte 44: float sample 0 is 1000.5"), std::string::npos) << over;
+  const std::string nan = message_of(float32_file({0.0f, std::nanf("")}));
+  EXPECT_NE(nan.find("byte 48: float sample 1 is a NaN or an infinity"), std::string::npos) << nan;
+  // A 64-bit 1e300 is finite: named as the number it is (it used to overflow to infinity in float first).
+  std::vector<std::uint8_t> f64;
+  const double big = 1e300;
+  std::uint64_t du;
+  std::memcpy(&du, &big, 8);
+  put32(f64, static_cast<std::uint32_t>(du));
+  put32(f64, static_cast<std::uint32_t>(du >> 32));
+  const std::string wide = message_of(wav_bytes(3, 1, 48000, 64, f64));
+  EXPECT_NE(wide.find("byte 44: float sample 0 is 1e+300"), std::string::npos) << wide;
 }
 
 TEST(WavReader, GarbageNeverCrashes) {
