@@ -39,7 +39,7 @@ EnvelopeFollower::EnvelopeFollower(int sample_rate, const EnvelopeSettings& sett
   require(sample_rate >= 1000 && sample_rate <= 768000, "the sample rate must be in [1000, 768000] Hz");
   settings.validate();
   const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(settings.window_ms * 1e-3 * rate_)));
-  window_.assign(n, 0.0f);
+  window_.assign(n, 0.0);
   attack_ = smoothing_factor(settings.attack_ms, rate_);
   release_ = smoothing_factor(settings.release_ms, rate_);
   if (settings.noise_floor >= 0)
@@ -64,14 +64,15 @@ void EnvelopeFollower::push(const float* mono, std::size_t count) {
 
 void EnvelopeFollower::push(float sample) {
   const std::size_t n = window_.size();
-  // Squared in double: the square of any finite float is finite there (at most 1.2e77), where a float
-  // square of a sample past 1.8e19 would be infinite and the running sum then NaN for good.
+  // Squared in double: the square of any finite float is finite there (at most 1.2e77). A float square
+  // of a sample past 1.8e19 is infinite: the window's RMS then was too, the smoothed envelope with it,
+  // and once the RMS came back the envelope's step inf - inf left it NaN for good (v0 read 0).
   const double square = static_cast<double>(sample) * sample;
   sum_ += square - window_[head_];
   window_[head_] = square;
   if (++head_ == n) {
     head_ = 0;
-    // Once per window, re-add the window exactly so rounding in the running sum cannot build up.
+    // Once per window, add the window up afresh so that rounding in the running sum cannot build up.
     double exact = 0;
     for (double s : window_) exact += s;
     sum_ = exact;

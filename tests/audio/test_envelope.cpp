@@ -63,8 +63,9 @@ TEST(Envelope, QuietThenBurstRisesWithinFiftyMilliseconds) {
   EXPECT_GT(f.v0(), 0.5 * during);
 }
 
-// Any finite sample keeps the follower finite (a float square overflows past 1.8e19: the running sum
-// then went NaN and the envelope stayed NaN, so v0 read 0, no wind, for the rest of the recording). The
+// Any finite sample keeps the follower finite (a float square overflows past 1.8e19: the window's RMS
+// then was infinite, and the envelope went NaN for good, so v0 read 0, no wind, for the rest of the
+// recording). The
 // loudest sample read_wav lets through, 1000 (60 dB above full scale), holds the wind at its strongest
 // for a moment and then lets the breath's own v0 come back.
 TEST(Envelope, AHugeSampleNeitherStopsTheWindNorHoldsIt) {
@@ -104,7 +105,7 @@ TEST(Envelope, GivenNoiseFloorSkipsCalibration) {
   EXPECT_FALSE(f.calibrating());
   // A 0.1-amplitude square wave: RMS 0.1 exactly; v0 = 10 * (0.1 - 0.05) = 0.5 m/s once settled.
   for (int i = 0; i < 48000; ++i) f.push(i % 2 ? 0.1f : -0.1f);
-  EXPECT_NEAR(f.v0(), 0.5, 1e-6);  // float squares summed exactly per window: rounding only
+  EXPECT_NEAR(f.v0(), 0.5, 1e-6);  // squares added up afresh per window: rounding only
 }
 
 TEST(SpeedSeries, InterpolatesAndHoldsEnds) {
