@@ -1,8 +1,8 @@
 // aloft_bench: the cost of a simulation step, and of the tree solver's factor and solve alone.
 //
-//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (aloft/state.hpp: swinging_state), collisions off
-//                        (issue 2's figure): presets from mobiles/ and generated mobiles of 15 ... 65535
-//                        components
+//   BM_Step/<mobile>     Simulation::step() on a swinging mobile (aloft/state.hpp: swinging_state),
+//                        collisions off (issue 2's figure): presets from mobiles/ and generated mobiles
+//                        of 15 ... 65535 components
 //   BM_StepCollisions/<mobile>  the same with collisions on (issue 3's figure)
 //   BM_StepSpan/<mobile>/off, .../on  the same over a fixed number of steps (span_steps), so that with
 //                        collisions off and on the same motion is timed: BM_Step and BM_StepCollisions
