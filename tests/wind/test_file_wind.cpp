@@ -13,7 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <sstream>
 #include <string>
 
 #include "support/run_aloft.hpp"
@@ -151,11 +151,18 @@ TEST_F(FileWindTest, SessionSwitchesSourcesAndKeepsTheSwitchAcrossAReload) {
 using Result = CliResult;
 const auto aloft = run_aloft;  // aloft("simulate ...")
 
-// The largest displacement from rest that `aloft simulate` reports (m), or -1.
+// The largest displacement from rest that `aloft simulate` reports (m), in its line "motion <x> m largest
+// displacement, ...", or -1.
 double largest_move(const std::string& output) {
-  std::smatch m;
-  if (!std::regex_search(output, m, std::regex("motion +([0-9.eE+-]+) m largest displacement"))) return -1;
-  return std::stod(m[1]);
+  for (std::size_t at = output.find("motion "); at != std::string::npos; at = output.find("motion ", at + 1)) {
+    std::istringstream words(output.substr(at + 7));
+    double metres = 0;
+    std::string unit, largest, displacement;
+    if (words >> metres >> unit >> largest >> displacement && unit == "m" && largest == "largest" &&
+        displacement.rfind("displacement", 0) == 0)  // "displacement," in the report
+      return metres;
+  }
+  return -1;
 }
 
 const std::string fan_room = std::string(ALOFT_SOURCE_DIR) + "/mobiles/fan-room.json";
