@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace aloft {
 
@@ -27,7 +28,7 @@ State swinging_state(const Model& model, double max_rate, std::uint64_t seed) {
   State state = rest_state(model);
   for (int i = 1; i < model.count; ++i) {
     const double z = 2 * unit() - 1;
-    const double phi = 2 * M_PI * unit();
+    const double phi = 2 * std::numbers::pi * unit();
     const double r = std::sqrt(std::max(0.0, 1 - z * z));
     const Vec3 axis(r * std::cos(phi), r * std::sin(phi), z);
     state.angular[i] = max_rate * (0.5 + 0.5 * unit()) * axis;
