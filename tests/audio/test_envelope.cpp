@@ -65,9 +65,8 @@ TEST(Envelope, QuietThenBurstRisesWithinFiftyMilliseconds) {
 
 // Any finite sample keeps the follower finite (a float square overflows past 1.8e19: the window's RMS
 // then was infinite, and the envelope went NaN for good, so v0 read 0, no wind, for the rest of the
-// recording). The
-// loudest sample read_wav lets through, 1000 (60 dB above full scale), holds the wind at its strongest
-// for a moment and then lets the breath's own v0 come back.
+// recording). The loudest sample read_wav lets through, 1000 (60 dB above full scale), holds the wind
+// at its strongest for a moment and then lets the breath's own v0 come back.
 TEST(Envelope, AHugeSampleNeitherStopsTheWindNorHoldsIt) {
   EnvelopeSettings settings;
   settings.noise_floor = 0;
