@@ -21,8 +21,6 @@
 #include <optional>
 #include <thread>
 
-#include <unistd.h>
-
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
@@ -110,7 +108,7 @@ std::optional<State> breeze_start(const Model& model, const std::string& name, s
     const double a = 2.399963 * i;  // rad, the golden angle
     sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));  // N
   }
-  const bool show_progress = isatty(STDERR_FILENO) == 1;
+  const bool show_progress = is_terminal(stderr);
   const double started = thread_seconds();
   for (int s = 0; s < kBreezeSteps; ++s) {
     if (!sim.step()) {
