@@ -2,6 +2,7 @@
 // channels. Every malformed input becomes an InputError naming the file, the byte offset and the problem.
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +12,7 @@
 
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
+#include "common/little_endian.hpp"
 
 namespace aloft {
 
@@ -33,11 +35,8 @@ struct Reader {
   [[noreturn]] void fail(std::size_t offset, const std::string& problem) const {
     throw InputError(name, SourcePlace{"byte " + std::to_string(offset), 0, 0}, problem);
   }
-  std::uint16_t u16(std::size_t at) const { return static_cast<std::uint16_t>(bytes[at] | (bytes[at + 1] << 8)); }
-  std::uint32_t u32(std::size_t at) const {
-    return static_cast<std::uint32_t>(bytes[at]) | (static_cast<std::uint32_t>(bytes[at + 1]) << 8) |
-           (static_cast<std::uint32_t>(bytes[at + 2]) << 16) | (static_cast<std::uint32_t>(bytes[at + 3]) << 24);
-  }
+  std::uint16_t u16(std::size_t at) const { return little_endian_u16(bytes.data() + at); }
+  std::uint32_t u32(std::size_t at) const { return little_endian_u32(bytes.data() + at); }
   bool tag(std::size_t at, const char* four) const { return std::memcmp(bytes.data() + at, four, 4) == 0; }
 };
 
@@ -50,37 +49,21 @@ std::string format_number(double value) {
 
 // One float sample at `p` (little-endian, 32 or 64 bits), as stored: any value, NaN included.
 double decode_float(const std::uint8_t* p, int bits) {
-  if (bits == 32) {
-    std::uint32_t u = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                      (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-    float f;
-    std::memcpy(&f, &u, 4);
-    return f;
-  }
-  std::uint64_t u = 0;
-  for (int i = 7; i >= 0; --i) u = (u << 8) | p[i];
-  double d;
-  std::memcpy(&d, &u, 8);
-  return d;
+  return bits == 32 ? std::bit_cast<float>(little_endian_u32(p)) : std::bit_cast<double>(little_endian_u64(p));
 }
 
 // One integer sample at `p` (little-endian) as a float in [-1, 1].
 float decode_integer(const std::uint8_t* p, int bits) {
   switch (bits) {
     case 8: return (static_cast<int>(p[0]) - 128) / 128.0f;  // unsigned, offset 128
-    case 16: return static_cast<std::int16_t>(p[0] | (p[1] << 8)) / 32768.0f;
+    case 16: return static_cast<std::int16_t>(little_endian_u16(p)) / 32768.0f;
     case 24: {
       std::int32_t v = static_cast<std::int32_t>((static_cast<std::uint32_t>(p[0]) << 8) |
                                                  (static_cast<std::uint32_t>(p[1]) << 16) |
                                                  (static_cast<std::uint32_t>(p[2]) << 24)) >> 8;
       return static_cast<float>(v / 8388608.0);
     }
-    default: {
-      std::int32_t v = static_cast<std::int32_t>(static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                                                 (static_cast<std::uint32_t>(p[2]) << 16) |
-                                                 (static_cast<std::uint32_t>(p[3]) << 24));
-      return static_cast<float>(v / 2147483648.0);
-    }
+    default: return static_cast<float>(static_cast<std::int32_t>(little_endian_u32(p)) / 2147483648.0);
   }
 }
 

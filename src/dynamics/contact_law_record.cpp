@@ -13,6 +13,7 @@
 #include <string>
 
 #include "aloft/error.hpp"
+#include "common/little_endian.hpp"
 
 namespace aloft {
 
@@ -72,8 +73,7 @@ class RecordParser {
 
   std::uint32_t u32(const char* what) {
     if (bytes_.size() - at_ < 4) fail(at_, std::string("the file ends inside ") + what);
-    std::uint32_t value = 0;
-    for (int k = 0; k < 4; ++k) value |= static_cast<std::uint32_t>(bytes_[at_ + k]) << (8 * k);
+    const std::uint32_t value = little_endian_u32(bytes_.data() + at_);
     at_ += 4;
     return value;
   }
