@@ -27,8 +27,9 @@ constexpr std::uint32_t kVersion = 1;
 constexpr bool kHostIsLittleEndian = std::endian::native == std::endian::little;
 static_assert(kHostIsLittleEndian || std::endian::native == std::endian::big, "mixed-endian hosts are not supported");
 
-// Reverses the bytes of each of `count` values of `size` bytes at `data` (in place).
-void reverse_each(unsigned char* data, std::size_t count, std::size_t size) {
+// Reverses the bytes of each of `count` values of `size` bytes at `data` (in place). Called on big-endian
+// hosts only (behind `if constexpr`), hence maybe_unused: clang warns of it on little-endian ones.
+[[maybe_unused]] void reverse_each(unsigned char* data, std::size_t count, std::size_t size) {
   for (std::size_t k = 0; k < count; ++k) std::reverse(data + k * size, data + (k + 1) * size);
 }
 
