@@ -1,9 +1,9 @@
 // aloft_step_profile: a fixed, repeatable stepping run for profilers (valgrind --tool=callgrind counts
 // instructions deterministically, so two builds can be compared on a busy machine) and a quick CPU-time
 // figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), or
-// starts from the benchmarks' swinging state (aloft/state.hpp: swinging_state, as BM_Step and BM_StepSpan do; one
-// step is taken first, for the first factorization), then `steps` steps are taken inside timed_steps(),
-// the function to give callgrind's --toggle-collect.
+// starts from the benchmarks' swinging state (aloft/state.hpp: swinging_state, as BM_Step and
+// BM_StepSpan do; one step is taken first, for the first factorization), then `steps` steps are taken
+// inside timed_steps(), the function to give callgrind's --toggle-collect.
 //
 //   aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]]
 //                      MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
