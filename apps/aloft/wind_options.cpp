@@ -55,6 +55,21 @@ CLI::Validator non_negative() {
       "");
 }
 
+// A steady wind speed v0 (m/s) the cone model takes (aloft/wind.hpp: kFastestWind).
+CLI::Validator wind_speed() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(input, &used);
+          if (used == input.size() && acceptable_wind_speed(v)) return {};
+        } catch (const std::exception&) {
+        }
+        return wind_speed_rule() + ", got \"" + input + "\"";
+      },
+      "");
+}
+
 // Centre and radius (m) of a sphere around the whole mobile at `state`.
 std::pair<Vec3, double> mobile_sphere(const Model& model, const State& state) {
   Bounds world;
@@ -104,9 +119,9 @@ std::string profile_text(const WindProfileSpec& p) {
 
 void add_wind_options(CLI::App* sub, WindOptions& o) {
   const char* group = "Wind (the paper's cone; see docs/wind.md)";
-  auto* constant = sub->add_option("--wind", o.constant, "Blow a steady wind: speed v0 at the source disc S0 (m/s, >= 0)")
+  auto* constant = sub->add_option("--wind", o.constant, "Blow a steady wind: speed v0 at the source disc S0 (m/s, 0 to 100)")
                        ->type_name("V0")
-                       ->check(non_negative())
+                       ->check(wind_speed())
                        ->group(group);
   auto* speed = sub->add_option("--wind-speed", o.speed_csv,
                                 "Wind speed v0 over time from a CSV of \"t,v0\" rows (s, m/s; linear in between, "

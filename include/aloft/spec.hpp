@@ -88,6 +88,19 @@ struct WindProfileSpec {
   double factor(double t) const;
 };
 
+// The fastest wind v0 at S0 (m/s) that the mobile file, the command line and a speed series may ask for.
+// The cone's continuity (eq. 2) and drag (eqs. 3-4) treat the air as incompressible, which holds to a few
+// percent below about 0.3 of the speed of sound (343 m/s at 20 C: the density changes by about M^2 / 2,
+// 4.5 % at M = 0.3). A breath is a few m/s, a fan 5-10 m/s, and the microphone's wind stops at 20 m/s
+// (EnvelopeSettings::max_v0). Wind::apply (wind.hpp) itself takes any v0.
+inline constexpr double kFastestWind = 100.0;
+
+// Whether a wind speed from outside keeps the rule (0 <= v0 <= kFastestWind, so finite), and the rule
+// worded for an error message that names where the speed came from and ends with what it was:
+// "<place>: must be from 0 to 100 m/s (the cone model ...), got 150".
+bool acceptable_wind_speed(double v0);
+std::string wind_speed_rule();
+
 // A wind source the file places in the room (a fan, an air vent): the paper's cone with its disc S0
 // centred at `from`, blowing towards `to`, the vertex l0 behind S0 (WindSource::aimed(from, to, r0, l0)).
 struct WindSourceSpec {
@@ -96,7 +109,7 @@ struct WindSourceSpec {
   Vec3 to = Vec3::Zero();                   // a point on its axis that it blows towards, world, m (!= from)
   double r0 = 0.25;                         // radius of S0, m (> 0)
   double l0 = 1.0;                          // vertex to S0, m (> 0)
-  double speed = 0;                         // v0 at S0 at full strength, m/s (>= 0)
+  double speed = 0;                         // v0 at S0 at full strength, m/s (0 to kFastestWind)
   WindProfileSpec profile;
   // Per-source overrides of the wind's settings (WindSettings); empty: the run's value.
   std::optional<double> alpha;              // kg m (> 0); run default: air, kAirDensity * l0^4
@@ -138,7 +151,7 @@ struct MobileSpec {
 
 // Parse a mobile file. Throws InputError (file, JSON path, line, problem) for unreadable files, JSON
 // syntax errors, missing or unknown keys, wrong types, non-finite or non-positive sizes, bad colours,
-// bad wind sources (from == to, r0 or l0 not positive, negative speed, a profile out of range) or camera
+// bad wind sources (from == to, r0 or l0 not positive, a speed outside 0 to kFastestWind, a profile out of range) or camera
 // values out of range, malformed or missing OBJ meshes (paths relative to the mobile file). Meaning across components
 // (parents, cycles, the fixed component, balance) is compile()'s job.
 MobileSpec parse_mobile_file(const std::string& path);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "aloft/audio.hpp"
+#include "aloft/spec.hpp"
 
 namespace aloft {
 
@@ -31,7 +32,7 @@ void EnvelopeSettings::validate() const {
   require(std::isfinite(calibration_s) && calibration_s >= 0 && calibration_s <= 60,
           "the noise calibration must last 0 to 60 s");
   require(std::isfinite(noise_floor) && noise_floor <= 1, "the noise floor must be an RMS <= 1 (or < 0: calibrate)");
-  require(std::isfinite(max_v0) && max_v0 > 0, "the largest v0 must be > 0 m/s");
+  require(max_v0 > 0 && acceptable_wind_speed(max_v0), "the largest v0 must be > 0 m/s and at most kFastestWind");
 }
 
 EnvelopeFollower::EnvelopeFollower(int sample_rate, const EnvelopeSettings& settings)

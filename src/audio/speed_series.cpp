@@ -9,6 +9,7 @@
 
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
+#include "aloft/spec.hpp"
 
 namespace aloft {
 
@@ -62,7 +63,7 @@ SpeedSeries read_speed_csv(const std::string& path) {
       if (series.t.empty() && !t_ok && !v_ok) continue;  // a header line such as "t,v0"
       fail("expected two numbers \"t,v0\", got \"" + text + "\"");
     }
-    if (v < 0) fail("the speed v0 must be >= 0 m/s, got " + trim(text.substr(comma + 1)));
+    if (!acceptable_wind_speed(v)) fail("the speed v0 " + wind_speed_rule() + ", got " + trim(text.substr(comma + 1)));
     if (!series.t.empty() && t <= series.t.back())
       fail("times must increase: " + trim(text.substr(0, comma)) + " s after " + previous_t + " s");
     series.t.push_back(t);

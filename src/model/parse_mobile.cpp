@@ -449,7 +449,10 @@ WindSourceSpec Reader::wind_source(const json& v, const Path& path, std::size_t 
     fail(join(path, "to"), "must differ from \"from\" (the wind blows from \"from\" towards \"to\")");
   if (const json* x = find(v, "r0")) w.r0 = positive(*x, join(path, "r0"), "m, the radius of the disc S0");
   if (const json* x = find(v, "l0")) w.l0 = positive(*x, join(path, "l0"), "m, from the cone's vertex to S0");
-  w.speed = non_negative(require(v, path, "speed", "m/s, the wind speed v0 at the disc S0"), join(path, "speed"), "m/s");
+  const Path sp = join(path, "speed");
+  const json& speed = require(v, path, "speed", "m/s, the wind speed v0 at the disc S0");
+  w.speed = speed.is_number() ? speed.get<double>() : -1;
+  if (!speed.is_number() || !acceptable_wind_speed(w.speed)) fail(sp, wind_speed_rule() + ", got " + describe(speed));
   if (const json* x = find(v, "profile")) w.profile = wind_profile(*x, join(path, "profile"));
   if (const json* x = find(v, "alpha")) w.alpha = positive(*x, join(path, "alpha"), "kg m");
   if (const json* x = find(v, "beta")) w.beta = in_range(*x, join(path, "beta"), 0, 10, "");

@@ -1,9 +1,11 @@
 // The time profile of a wind source placed by a mobile file (spec.hpp): steady, switched on and off, or
-// swelling like a vent that breathes.
+// swelling like a vent that breathes; and the fastest wind speed a run is given.
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <string>
 
 #include "aloft/spec.hpp"
 
@@ -22,5 +24,14 @@ double WindProfileSpec::factor(double t) const {
   if (ramp > 0 && cycle < on + ramp) return 1 - (cycle - on) / ramp;
   return 0;
 }
+
+std::string wind_speed_rule() {
+  char text[64];
+  std::snprintf(text, sizeof text, "must be from 0 to %g m/s", kFastestWind);
+  return std::string(text) +
+         " (the cone model treats the air as incompressible, which holds below about 0.3 of the speed of sound)";
+}
+
+bool acceptable_wind_speed(double v0) { return v0 >= 0 && v0 <= kFastestWind; }
 
 }  // namespace aloft

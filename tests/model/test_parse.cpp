@@ -856,7 +856,12 @@ TEST(ParseScene, BadWindSourcesAndCamerasNameFilePathAndLine) {
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"r0\": 0}]", "wind_sources[0].r0", "\"r0\"", "must be a positive number"},
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"l0\": -1}]", "wind_sources[0].l0", "\"l0\"", "must be a positive number"},
       {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [0, 1, 0],\n     \"speed\": -0.5}]",
-       "wind_sources[0].speed", "\"speed\"", "must be a number >= 0 (m/s), got -0.5"},
+       "wind_sources[0].speed", "\"speed\"", "must be from 0 to 100 m/s (the cone model treats the air as "
+       "incompressible, which holds below about 0.3 of the speed of sound), got -0.5"},
+      // Faster than the cone model's incompressible air (kFastestWind).
+      {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [0, 1, 0],\n     \"speed\": 150}]",
+       "wind_sources[0].speed", "\"speed\"", "must be from 0 to 100 m/s (the cone model treats the air as "
+       "incompressible, which holds below about 0.3 of the speed of sound), got 150"},
       {"  \"wind_sources\": [\n    {\"from\": [1, 1, 0], \"to\": [0, 1, 0],\n     \"speed\": true}]",
        "wind_sources[0].speed", "\"speed\"", "got true"},
       {"  \"wind_sources\": [\n    {\"from\": [1, 1e999, 0], \"to\": [0, 1, 0], \"speed\": 1}]",

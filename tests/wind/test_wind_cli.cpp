@@ -36,6 +36,10 @@ TEST(WindCli, SpeedSeriesAndAudioDriveTheWind) {
   r = aloft("simulate " + fish + " -t 0.2 --wind-speed " + dir + "bad_speeds.csv");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("bad_speeds.csv:2: expected two numbers"), std::string::npos) << r.output;
+  std::ofstream(dir + "gale.csv") << "t,v0\n0,1\n0.1,1e5\n";
+  r = aloft("simulate " + fish + " -t 0.2 --wind-speed " + dir + "gale.csv");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.output.find("gale.csv:3: the speed v0 must be from 0 to 100 m/s"), std::string::npos) << r.output;
   std::ofstream(dir + "not.wav") << "this is not a wav file";
   r = aloft("simulate " + fish + " -t 0.2 --wind-audio " + dir + "not.wav");
   EXPECT_EQ(r.code, 1);
@@ -53,6 +57,14 @@ TEST(WindCli, BadFlagsAreUsageErrors) {
   EXPECT_EQ(r.code, 2) << r.output;
   r = aloft("simulate " + fish + " -t 0.2 --wind -1");
   EXPECT_EQ(r.code, 2) << r.output;
+  // Faster than the cone model's incompressible air: refused by name, not run until a component spins
+  // too fast (as --wind 1e5 did, exit 3, at the first step).
+  r = aloft("simulate " + fish + " -t 0.2 --wind 1e5");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--wind: must be from 0 to 100 m/s (the cone model treats the air as incompressible"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(aloft("simulate " + fish + " -t 0.01 --wind 100 --no-collisions").code, 0);  // the limit itself
   r = aloft("simulate " + fish + " -t 0.2 --wind 1 --wind-from 0,2,0 --wind-to 0,2,0");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("two different points"), std::string::npos) << r.output;
