@@ -167,15 +167,16 @@ Runner add_simulate(CLI::App& app) {
   add_wind_options(sub, o->wind);
   sub->footer(
       "Starts from the designed pose at rest and prints a summary: steps, simulated and wall time, speed,\n"
-      "energy drift, the largest joint separation seen, and the collisions: their impulses, the deepest\n"
-      "overlap, the energy they took out, and the pairs of components that touched (were pushed apart by a\n"
-      "contact impulse, or came within 0.1 mm), the most often first. With --contacts-out, also writes\n"
-      "every such pair as CSV: header component_a,component_b,steps,first_t,last_t,deepest_overlap_m (the\n"
-      "steps in which they touched, the end times of the first and last of them in s, the largest overlap\n"
-      "in m). With --out, also writes the trajectory as CSV:\n"
-      "header t,component,x,y,z,qw,qx,qy,qz, one row per component (by name) per output frame, a frame\n"
-      "every --every steps with t = 0 included; x,y,z is the centre of mass and qw,qx,qy,qz the orientation\n"
-      "of the component's principal frame (as 'aloft inspect' rest_orientation), world frame, SI units.\n"
+      "energy drift (energy change, with wind or damping), the largest joint separation seen, and the\n"
+      "collisions: their impulses, the deepest overlap, the energy they took out, and the pairs of\n"
+      "components that touched (were pushed apart by a contact impulse, or came within 0.1 mm), the most\n"
+      "often first. With --contacts-out, also writes every such pair as CSV: header\n"
+      "component_a,component_b,steps,first_t,last_t,deepest_overlap_m (the steps in which they touched,\n"
+      "the end times of the first and last of them in s, the largest overlap in m). With --out, also\n"
+      "writes the trajectory as CSV: header t,component,x,y,z,qw,qx,qy,qz, one row per component (by\n"
+      "name) per output frame, a frame every --every steps with t = 0 included; x,y,z is the centre of mass\n"
+      "and qw,qx,qy,qz the orientation of the component's principal frame (as 'aloft inspect'\n"
+      "rest_orientation), world frame, SI units.\n"
       "\n"
       "Examples:\n"
       "  aloft simulate mobiles/steel-fish.json --duration 10\n"
@@ -263,8 +264,19 @@ Runner add_simulate(CLI::App& app) {
       else if (peak_kinetic > 1e-12)
         energy += format(" (%.3g %% of the largest kinetic energy seen, %.3e J)", 100 * drift / peak_kinetic,
                          peak_kinetic);
-      if (!o->damping_off && (model.damping.linear > 0 || model.damping.angular > 0))
+      // A drift only when nothing else changes the energy: the wind does work and damping takes energy
+      // out, so with either the line says what it is and how to check conservation instead.
+      const bool damping_on = !o->damping_off && (model.damping.linear > 0 || model.damping.angular > 0);
+      const bool wind_blows = !wind.empty();
+      if (wind_blows && damping_on)
+        energy += "; the wind does work and damping is on (no wind and --damping-off to check conservation)";
+      else if (wind_blows)
+        energy += "; the wind does work (no wind to check conservation)";
+      else if (damping_on)
         energy += "; damping is on (--damping-off to check conservation)";
+      if (sim.collisions() && sim.collision_statistics().energy_removed > 0)
+        energy += format("; the contacts took out %.4g J", sim.collision_statistics().energy_removed);
+      const char* energy_label = wind_blows || damping_on ? "energy change" : "energy drift ";
       std::printf("mobile            %s\n", model.name.c_str());
       std::printf("components        %d\n", model.count);
       std::printf("steps             %lld (dt = %g s)\n", done, h);
@@ -272,7 +284,7 @@ Runner add_simulate(CLI::App& app) {
       std::printf("wall time         %.3f s\n", wall);
       std::printf("speed             %.0f steps/s (%.3g x real time)\n", wall > 0 ? done / wall : 0.0,
                   wall > 0 ? s.time / wall : 0.0);
-      std::printf("energy drift      %s\n", energy.c_str());
+      std::printf("%s     %s\n", energy_label, energy.c_str());
       std::printf("joint separation  %.3e m (largest seen)\n", worst_separation);
       std::printf("motion            %.3g m largest displacement, %.3g deg largest turn (from rest, every %d steps)\n",
                   largest_move, largest_turn * 180 / 3.141592653589793, o->every);

@@ -24,6 +24,12 @@ TEST(WindCli, SteadyWindRunsAndReports) {
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("wind              v0 = 2.5 m/s, steady"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("occlusion         18 refreshes"), std::string::npos) << r.output;  // 300 steps / 17
+  // The wind does work, so the energy's change is no drift, and the summary does not call it one.
+  EXPECT_EQ(r.output.find("energy drift"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("energy change"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the wind does work and damping is on (no wind and --damping-off to check conservation)"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST(WindCli, SpeedSeriesAndAudioDriveTheWind) {
