@@ -182,10 +182,7 @@ int main(int argc, char** argv) {
     if (swinging) {
       if (!sim.step()) throw std::runtime_error(sim.failure()->message);
     } else {
-      for (int i = 1; i < model.count; ++i) {
-        const double a = 2.399963 * i;  // golden angle, as in `aloft bench`
-        sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
-      }
+      set_breeze(model, sim.loads());  // as `aloft bench`
       for (int k = 0; k < 300; ++k)
         if (!sim.step()) throw std::runtime_error(sim.failure()->message);
       sim.loads().clear();

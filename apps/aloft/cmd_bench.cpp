@@ -103,11 +103,7 @@ std::optional<BenchStart> parse_start(const std::string& text) {
 std::optional<State> breeze_start(const Model& model, const std::string& name, std::string& failure) {
   Simulation sim(model);
   sim.set_collisions(true);
-  sim.loads().resize(model.count);
-  for (int i = 1; i < model.count; ++i) {
-    const double a = 2.399963 * i;  // rad, the golden angle
-    sim.loads().force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));  // N
-  }
+  set_breeze(model, sim.loads());
   const bool show_progress = is_terminal(stderr);
   const double started = thread_seconds();
   for (int s = 0; s < kBreezeSteps; ++s) {

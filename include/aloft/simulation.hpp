@@ -45,6 +45,13 @@ struct ExternalLoads {
   void clear();
 };
 
+// The benchmarks' breeze, which sets a mobile knocking as a room's draught would (`aloft bench`'s
+// default start, aloft_step_profile's "breeze", and the tests that need a generated mobile's pieces to
+// touch): a horizontal push of 0.2 g (0.2 * 9.81 m/s^2 times each component's mass, N) on every moving
+// component, its direction turning by the golden angle from one component to the next. Sets `loads`'s
+// forces (sized to the model; torques untouched); they act until the caller clears them.
+void set_breeze(const Model& model, ExternalLoads& loads);
+
 // Running totals of the collision response since the simulation started.
 struct CollisionStatistics {
   long long steps_with_contacts = 0;  // (sub)steps in which the detector reported contacts

@@ -20,6 +20,14 @@ void ExternalLoads::clear() {
   std::fill(torque.begin(), torque.end(), Vec3::Zero());
 }
 
+void set_breeze(const Model& model, ExternalLoads& loads) {
+  if (static_cast<int>(loads.force.size()) != model.count) loads.resize(model.count);
+  for (int i = 1; i < model.count; ++i) {
+    const double a = 2.399963 * i;  // rad, the golden angle: directions spread round the circle
+    loads.force[i] = 0.2 * 9.81 * model.mass[i] * Vec3(std::cos(a), 0, std::sin(a));
+  }
+}
+
 namespace {
 
 // Joint positions must agree to kJointToleranceRate h^2 (m, per coordinate), and never need to agree

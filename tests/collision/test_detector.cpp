@@ -10,7 +10,6 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 #include "collision/broad_phase.hpp"
-#include "support/breeze.hpp"
 #include "support/shaking.hpp"
 
 namespace aloft {
@@ -154,7 +153,7 @@ TEST(Detector, PairListKeptUpToDateGivesTheContactsOfAFreshDetectorOnALargeMobil
   options.components = 1023;
   const Model m = compile(parse_mobile_text(generate_mobile(options), "generated-1023.json"));
   Simulation sim(m);
-  test::blow_bench_breeze(m, sim);
+  set_breeze(m, sim.loads());
   CollisionDetector steady(m), forgetful(m);
   forgetful.set_coherence(false);
   std::vector<Contact> remembered, fresh_contacts;

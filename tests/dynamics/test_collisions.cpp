@@ -15,7 +15,6 @@
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
-#include "support/breeze.hpp"
 #include "support/leaning_balls.hpp"
 #include "support/presets.hpp"
 #include "support/shaking.hpp"
@@ -481,7 +480,7 @@ TEST(Collisions, EnergyTakenOutIsTheEnergyLost) {
   const Model model = compile(spec);
   Simulation sim(model);
   ASSERT_TRUE(sim.collisions());
-  test::blow_bench_breeze(model, sim);
+  set_breeze(model, sim.loads());
   ASSERT_TRUE(sim.advance(0.3)) << sim.failure()->message;
   sim.loads().clear();
   const double start = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state());
@@ -546,7 +545,7 @@ TEST(Collisions, CrowdedGeneratedMobileInABreezeKeepsGoing) {
   const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-1023.json"));
   Simulation sim(model);
   ASSERT_TRUE(sim.collisions());
-  test::blow_bench_breeze(model, sim);
+  set_breeze(model, sim.loads());
   ASSERT_TRUE(sim.advance(0.3)) << sim.failure()->message;
   sim.loads().clear();
   const double kinetic = kinetic_energy(model, sim.state());

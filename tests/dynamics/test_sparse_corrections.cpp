@@ -15,7 +15,6 @@
 #include "aloft/simulation.hpp"
 #include "aloft/spec.hpp"
 
-#include "support/breeze.hpp"
 
 namespace aloft {
 namespace {
@@ -174,7 +173,7 @@ TEST(SparseCorrections, ContactPassesDriftOnlyWhatTheirImpulsesMoveAndEndWhereFu
   const Model model = compile(parse_mobile_text(generate_mobile(options), "generated-255.json"));
   Simulation sim(model);
   ASSERT_TRUE(sim.collisions());
-  test::blow_bench_breeze(model, sim);
+  set_breeze(model, sim.loads());
   ASSERT_TRUE(sim.advance(1.0)) << sim.failure()->message;
   sim.loads().clear();
   const double h = model.timestep;
