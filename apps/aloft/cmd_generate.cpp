@@ -23,7 +23,10 @@ Runner add_generate(CLI::App& app) {
       ->type_name("N")
       ->required()
       ->check(integer_in(2, 1 << 24));
-  sub->add_option("-s,--seed", o->seed, "Random seed")->type_name("S")->capture_default_str();
+  sub->add_option("-s,--seed", o->seed, "Random seed (0 to 4294967295)")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(integer_in(0, 4294967295LL));
   sub->add_option("-m,--total-mass", o->total_mass, "Total mass of the moving components (kg, > 0)")
       ->type_name("KG")
       ->capture_default_str()

@@ -48,17 +48,17 @@ Runner add_mic(CLI::App& app) {
   sub->add_option("-t,--duration", o->duration, "Stop after this much audio (s); default: until Ctrl-C")
       ->type_name("T")
       ->check(positive_number());
-  sub->add_option("--gain", o->gain, "m/s of v0 per unit of RMS above the noise floor (>= 0)")
+  sub->add_option("--gain", o->gain, "m/s of v0 per unit of RMS above the noise floor (0 to 1e6)")
       ->type_name("G")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(number_in(0.0, 1e6));
   sub->add_option("--noise-floor", o->noise_floor, "Noise floor (RMS, 0 to 1) instead of calibrating it")
       ->type_name("RMS")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--calibrate", o->calibrate, "Seconds of room sound at the start that set the noise floor")
+      ->check(number_in(0.0, 1.0));
+  sub->add_option("--calibrate", o->calibrate, "Seconds of room sound at the start that set the noise floor (0 to 60)")
       ->type_name("S")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0));
+      ->check(number_in(0.0, 60.0));
   sub->add_option("--rate", o->rate, "Sample rate to capture at (Hz)")
       ->type_name("HZ")
       ->capture_default_str()

@@ -92,7 +92,7 @@ Runner add_render(CLI::App& app) {
   sub->add_option("--height", o->height, "Image height (pixels)")->capture_default_str()->check(integer_in(16, 8192));
   sub->add_option("--fps", o->fps, "Frames per simulated second (1..240)")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 240.0));
+      ->check(number_in(1.0, 240.0));
   sub->add_option("--msaa", o->samples, "Anti-aliasing samples per pixel (0 or 1: off)")
       ->capture_default_str()
       ->check(integer_in(0, 16));

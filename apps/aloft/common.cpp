@@ -80,9 +80,6 @@ std::string source_dir() {
 #endif
 }
 
-namespace {
-
-// The whole of `input` read as a double, or nothing.
 std::optional<double> read_number(const std::string& input) {
   try {
     std::size_t used = 0;
@@ -93,14 +90,23 @@ std::optional<double> read_number(const std::string& input) {
   return std::nullopt;
 }
 
-}  // namespace
-
 CLI::Validator positive_number() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
         const std::optional<double> v = read_number(input);
         if (!v) return "must be a number, got \"" + input + "\"";
         if (!(*v > 0) || !std::isfinite(*v)) return "must be a positive number, got " + input;
+        return {};
+      },
+      "");
+}
+
+CLI::Validator number_in(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& input) -> std::string {
+        const std::optional<double> v = read_number(input);
+        if (!v || !(*v >= lo && *v <= hi))  // NaN fails too
+          return format("must be a number from %g to %g, got \"", lo, hi) + input + "\"";
         return {};
       },
       "");

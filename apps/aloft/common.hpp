@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,8 +80,12 @@ void write_file(const std::string& path, const std::string& text);
 // Directory of the source tree this program was built from (for the preset mobiles).
 std::string source_dir();
 
-// Validators with clear messages.
+// The whole of `input` read as a number (std::stod: "1e5", "inf" and "nan" included), or nothing.
+std::optional<double> read_number(const std::string& input);
+
+// Validators with clear messages ("must be ..., got \"X\""), in the words the option's help uses.
 CLI::Validator positive_number();          // > 0
+CLI::Validator number_in(double lo, double hi);  // a number in [lo, hi]
 CLI::Validator timestep_range();           // (0, 0.01]
 CLI::Validator integer_in(long long lo, long long hi);  // an integer in [lo, hi]
 

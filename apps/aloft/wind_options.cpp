@@ -20,13 +20,9 @@ std::optional<Vec3> read_point(const std::string& text) {
   for (int i = 0; i < 3; ++i) {
     std::string field;
     if (!std::getline(in, field, ',')) return std::nullopt;
-    try {
-      std::size_t used = 0;
-      p[i] = std::stod(field, &used);
-      if (used != field.size() || !std::isfinite(p[i])) return std::nullopt;
-    } catch (const std::exception&) {
-      return std::nullopt;
-    }
+    const std::optional<double> coordinate = read_number(field);
+    if (!coordinate || !std::isfinite(*coordinate)) return std::nullopt;
+    p[i] = *coordinate;
   }
   std::string rest;
   if (std::getline(in, rest)) return std::nullopt;
@@ -44,12 +40,8 @@ CLI::Validator point_validator() {
 CLI::Validator non_negative() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        try {
-          std::size_t used = 0;
-          const double v = std::stod(input, &used);
-          if (used == input.size() && std::isfinite(v) && v >= 0) return {};
-        } catch (const std::exception&) {
-        }
+        const std::optional<double> v = read_number(input);
+        if (v && std::isfinite(*v) && *v >= 0) return {};
         return "must be a number >= 0, got \"" + input + "\"";
       },
       "");
@@ -59,12 +51,8 @@ CLI::Validator non_negative() {
 CLI::Validator wind_speed() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        try {
-          std::size_t used = 0;
-          const double v = std::stod(input, &used);
-          if (used == input.size() && acceptable_wind_speed(v)) return {};
-        } catch (const std::exception&) {
-        }
+        const std::optional<double> v = read_number(input);
+        if (v && acceptable_wind_speed(*v)) return {};
         return wind_speed_rule() + ", got \"" + input + "\"";
       },
       "");
@@ -161,7 +149,7 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
   sub->add_option("--wind-beta", o.beta, "Turbulence: |F_random| < beta |F_stoke| (0: none, up to 10)")
       ->type_name("B")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0))
+      ->check(number_in(0.0, 10.0))
       ->group(group);
   sub->add_option("--wind-gust-time", o.gust_time, "Correlation time of the turbulence (s, >= 0)")
       ->type_name("S")
@@ -196,13 +184,13 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
   sub->add_option("--wind-noise-floor", o.noise_floor,
                   "With --wind-audio: the noise floor (RMS, 0 to 1) instead of calibrating it")
       ->type_name("RMS")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(number_in(0.0, 1.0))
       ->group(group);
   sub->add_option("--wind-calibrate", o.calibrate,
-                  "With --wind-audio: seconds of room sound at the start that set the noise floor")
+                  "With --wind-audio: seconds of room sound at the start that set the noise floor (0 to 60)")
       ->type_name("S")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0))
+      ->check(number_in(0.0, 60.0))
       ->group(group);
   add_no_file_wind_flag(sub, o.no_file_wind);
 }

@@ -281,6 +281,26 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   }
 }
 
+// Every number out of its range is named with the range the option's help gives, in the same words
+// across the commands (not CLI11's "Value 20 not in range 0.000000 to 10.000000" or "Could not convert").
+TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
+  write(dir_ / "small.json", kSmallMobile);
+  const std::pair<const char*, const char*> cases[] = {
+      {"generate -n 5 -s -3", "--seed: must be an integer from 0 to 4294967295, got \"-3\""},
+      {"simulate small.json -t 1 --wind 1 --wind-beta 20", "--wind-beta: must be a number from 0 to 10, got \"20\""},
+      {"simulate small.json -t 1 --wind-audio x.wav --wind-noise-floor nan",
+       "--wind-noise-floor: must be a number from 0 to 1, got \"nan\""},
+      {"render small.json -t 1 --fps abc --out x.png", "--fps: must be a number from 1 to 240, got \"abc\""},
+      {"render small.json -t 1 --pitch 90 --out x.png", "--pitch: must be a number from -85 to 85, got \"90\""},
+      {"render small.json -t 1 --distance -1 --out x.png", "--distance: must be a positive number, got -1"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result r = aloft(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
 TEST_F(Cli, HelpAndVersion) {
   for (const char* sub : {"", "generate ", "inspect ", "simulate ", "bench "}) {
     const Result r = aloft(std::string(sub) + "--help");

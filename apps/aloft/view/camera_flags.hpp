@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "aloft/render/camera.hpp"
+#include "../common.hpp"
 #include "file_camera.hpp"
 
 namespace aloft::cli {
@@ -28,15 +29,15 @@ struct CameraFlags {
         ->group("Camera");
     sub->add_option("--pitch", pitch_deg, "Camera height angle above the horizontal (degrees, -85..85)")
         ->type_name("DEG")
-        ->check(CLI::Range(-85.0, 85.0))
+        ->check(cli::number_in(-85.0, 85.0))
         ->group("Camera");
     sub->add_option("--distance", distance, "Camera distance from its target (m, > 0)")
         ->type_name("M")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::positive_number())
         ->group("Camera");
     sub->add_option("--fov", fov_deg, "Vertical field of view (degrees, 5..120)")
         ->type_name("DEG")
-        ->check(CLI::Range(5.0, 120.0))
+        ->check(cli::number_in(5.0, 120.0))
         ->group("Camera");
     sub->add_option("--target", target, "Point the camera looks at: X Y Z (m, world)")
         ->type_name("X Y Z")
