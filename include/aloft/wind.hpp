@@ -156,6 +156,23 @@ class Wind {
     Vec3 moment;            // sum of area * point, camera frame, m^3
   };
   const Vec3& triangle_point_body(std::size_t t) const { return triangle_point_body_[t]; }
+  // What a triangle's facet stands for. The mesh of a round surface (a wire's side, a sphere) is faceted,
+  // and a pixel's force, along its facet's normal at the pixel's point, misses the axis (centre) by up
+  // to half a facet's width; the true surface's pressure, along its own normals, meets it. So the points
+  // of a round facet's elements are moved along the facet, to where its normal meets the axis (centre):
+  // the surface pushes and turns its component as before, but not about its own axis.
+  struct RoundSurface {
+    enum class Kind : unsigned char { kFlat, kAxis, kCentre };
+    Kind kind = Kind::kFlat;
+    Vec3 point = Vec3::Zero();      // a point of the axis, or the centre; body frame, m
+    Vec3 direction = Vec3::Zero();  // kAxis: the axis, unit, body frame
+    // The surface a shape's facets stand for: a wire's side (its flat ends are flat: see
+    // through_axis), a sphere; plates, boxes and meshes are flat.
+    static RoundSurface of(const Shape& shape);
+    // `point_body` moved along a facet of normal `normal` (unit, body frame) to where the normal through
+    // it meets the axis or the centre; unchanged for a flat facet and a wire's end.
+    Vec3 through_axis(const Vec3& point_body, const Vec3& normal) const;
+  };
 
   const Model& model_;
   WindSource source_;
@@ -167,6 +184,7 @@ class Wind {
   std::vector<Vec3> triangle_point_body_;
   std::vector<int> triangle_component_;
   std::vector<int> triangle_plane_;
+  std::vector<RoundSurface> triangle_round_;
   int plane_count_ = 0;
   std::unique_ptr<internal::ItemRasterizer> rasterizer_;
   ItemBuffer buffer_;

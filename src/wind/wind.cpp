@@ -64,13 +64,20 @@ Wind::Wind(const Model& model, const WindSource& source, const WindSettings& set
   meshes_.resize(model.count);
   std::vector<Vec3> plane_normals;   // of the current component
   std::vector<double> plane_offsets;
+  std::vector<char> plane_is_round;  // made by a round shape's facets
   int plane_base = 0;
   for (int c = 0; c < model.count; ++c) {
     ComponentMesh& m = meshes_[c];
     plane_normals.clear();
     plane_offsets.clear();
+    plane_is_round.clear();
     for (const BodyShape& shape : model.shapes[c]) {
       const TriangleMesh mesh = shape_mesh(shape.shape, settings_.round_segments);
+      const RoundSurface round = RoundSurface::of(shape.shape);
+      const bool is_round = round.kind != RoundSurface::Kind::kFlat;
+      // A round shape's facets get planes of their own: an element's point is moved by the surface of
+      // one triangle of its plane (refresh_occlusion), which must then stand for all its pixels.
+      const std::size_t first_own_plane = is_round ? plane_normals.size() : 0;
       const int base = static_cast<int>(m.vertices.size());
       m.vertices.insert(m.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
       for (const auto& t : mesh.triangles) {
@@ -80,13 +87,14 @@ Wind::Wind(const Model& model, const WindSource& source, const WindSettings& set
         const Vec3 n = cross.normalized();
         const double offset = n.dot(a);
         int plane = -1;
-        for (std::size_t p = 0; p < plane_normals.size() && plane < 0; ++p)
-          if ((plane_normals[p] - n).norm() < kSamePlane && std::abs(plane_offsets[p] - offset) < kSamePlane)
+        for (std::size_t p = first_own_plane; p < plane_normals.size() && plane < 0; ++p)
+          if (plane_is_round[p] == is_round && (plane_normals[p] - n).norm() < kSamePlane && std::abs(plane_offsets[p] - offset) < kSamePlane)
             plane = static_cast<int>(p);
         if (plane < 0) {
           plane = static_cast<int>(plane_normals.size());
           plane_normals.push_back(n);
           plane_offsets.push_back(offset);
+          plane_is_round.push_back(is_round);
         }
         m.triangles.push_back({base + t[0], base + t[1], base + t[2]});
         m.plane_of_triangle.push_back(plane);
@@ -94,6 +102,7 @@ Wind::Wind(const Model& model, const WindSource& source, const WindSettings& set
         triangle_point_body_.push_back(a);
         triangle_component_.push_back(c);
         triangle_plane_.push_back(plane_base + plane);
+        triangle_round_.push_back(round);
       }
     }
     plane_base += static_cast<int>(plane_normals.size());
@@ -112,6 +121,35 @@ Wind::Wind(const Model& model, const WindSource& source, const WindSettings& set
 }
 
 Wind::~Wind() = default;
+
+Wind::RoundSurface Wind::RoundSurface::of(const Shape& shape) {
+  RoundSurface round;
+  if (const auto* wire = std::get_if<Wire>(&shape)) {
+    round.kind = Kind::kAxis;
+    round.point = wire->from;
+    round.direction = (wire->to - wire->from).normalized();
+  } else if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    round.kind = Kind::kCentre;
+    round.point = sphere->center;
+  }
+  return round;
+}
+
+Vec3 Wind::RoundSurface::through_axis(const Vec3& point_body, const Vec3& normal) const {
+  const Vec3 offset = point_body - point;
+  switch (kind) {
+    case Kind::kFlat:
+      return point_body;
+    case Kind::kCentre:  // on the normal through the centre, as far out as the point
+      return point + offset.dot(normal) * normal;
+    case Kind::kAxis:
+      // A wire's end (its normal along the axis; the sides' normals are square to it) is flat.
+      if (std::abs(normal.dot(direction)) > 0.5) return point_body;
+      // In the plane of the axis and the normal: the offset across the facet is dropped.
+      return point + offset.dot(direction) * direction + offset.dot(normal) * normal;
+  }
+  return point_body;
+}
 
 void Wind::set_source(const WindSource& source) {
   source.validate();
@@ -242,8 +280,10 @@ void Wind::refresh_occlusion(const State& state) {
         el.point_world = source_.vertex + frame_ * (e.moment / e.area);
         el.normal_world = frame_ * plane_n_[e.id];
         const Mat3 rotation = state.orientation[e.component].toRotationMatrix();
-        el.point_body = rotation.transpose() * (el.point_world - state.position[e.component]);
         el.normal_body = triangle_normal_body_[e.id - 1];
+        el.point_body = triangle_round_[e.id - 1].through_axis(
+            rotation.transpose() * (el.point_world - state.position[e.component]), el.normal_body);
+        el.point_world = state.position[e.component] + rotation * el.point_body;
         elements_.push_back(el);
       }
     }
