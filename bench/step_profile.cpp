@@ -2,11 +2,11 @@
 // instructions deterministically, so two builds can be compared on a busy machine) and a quick CPU-time
 // figure. The mobile is set swinging by the same breeze as `aloft bench` (0.2 g for 300 steps), or
 // starts from the benchmarks' swinging state (aloft/state.hpp: swinging_state, as BM_Step and
-// BM_StepSpan do; one step is taken first, for the first factorization), then `steps` steps are taken
-// inside timed_steps(), the function to give callgrind's --toggle-collect.
+// BM_StepSpan do) or from rest (one step is taken first for those two, for the first factorization),
+// then `steps` steps are taken inside timed_steps(), the function to give callgrind's --toggle-collect.
 //
-//   aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]]
-//                      MOBILE STEPS [collisions 0|1] [breeze|swinging[:SEED]] [joint tolerance, m]
+//   aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]] [--wind V0]
+//                      MOBILE STEPS [collisions 0|1] [rest|breeze|swinging[:SEED]] [joint tolerance, m]
 //     --every N: also print, after every N steps, the same figures for those N steps alone (how a run's
 //       cost changes along it: a generated mobile with collisions tangles, and its late steps cost many
 //       times its early ones; docs/performance.md), with the energy, the fastest spin and the deepest
@@ -14,6 +14,9 @@
 //     --record-law FILE: write the contact law's solves of the timed steps to FILE
 //       (aloft/contact_law_record.hpp), to be solved again by aloft_law_replay: every N-th (default 1) of
 //       those with M contacts or more (default 1)
+//     --wind V0: the steps after the start (the first one included) blown by the paper's wind, v0 m/s
+//       steady (TimedWind below: the mobile as it moves in its main use); the wind's own work is timed
+//       apart and printed, not counted in the step's figures
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
 //     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
 //       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
@@ -39,6 +42,7 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -47,13 +51,40 @@
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
 #include "aloft/thread_clock.hpp"
+#include "aloft/wind.hpp"
 #include "bench_models.hpp"
 
 namespace {
 
-__attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps) {
+// The paper's wind on the timed steps (--wind V0): a steady v0 from a source 1.5 m in front (+z) of the
+// mobile at rest, blowing along -z, its cone just covering the mobile (source_facing_mobile, as the
+// command line's default), the default settings (turbulence beta 0.3, seed 1), and the occlusion
+// refreshed every 17 steps (60 Hz at 1 ms, as `aloft simulate`). Its own work (refresh and apply) is
+// timed apart and left out of the step's figure, so both columns of a collisions on / off comparison
+// time the step alone.
+struct TimedWind {
+  std::unique_ptr<aloft::Wind> wind;
+  double v0 = 0;              // m/s at S0
+  long steps_taken = 0;       // steps blown so far (the refresh schedule)
+  double seconds = 0;         // thread CPU time spent in the wind's refresh and apply, s
+  static constexpr int kRefreshEvery = 17;
+};
+
+// One step of the run: the wind's loads first (timed apart), when there is a wind.
+bool take_step(aloft::Simulation& sim, TimedWind* wind) {
+  if (wind) {
+    const double start = aloft::thread_seconds();
+    if (wind->steps_taken++ % TimedWind::kRefreshEvery == 0) wind->wind->refresh_occlusion(sim.state());
+    sim.loads().clear();
+    wind->wind->apply(sim.state(), wind->v0, sim.timestep(), sim.loads());
+    wind->seconds += aloft::thread_seconds() - start;
+  }
+  return sim.step();
+}
+
+__attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps, TimedWind* wind) {
   for (long k = 0; k < steps; ++k)
-    if (!sim.step()) return false;
+    if (!take_step(sim, wind)) return false;
   return true;
 }
 
@@ -114,6 +145,7 @@ int main(int argc, char** argv) {
   long every = 0;  // --every N: steps per block of the per-block report (0: none)
   std::string record_path;  // --record-law FILE: the contact law's solves written there
   long record_every = 1, record_min = 1;  // --record-every N, --record-min M
+  double wind_v0 = 0;  // --wind V0: the timed steps in the paper's wind (m/s; 0: none)
   while (argc > 2 && std::string(argv[1]).starts_with("--")) {
     const std::string option = argv[1];
     const auto whole = [&](long& value) {
@@ -131,6 +163,14 @@ int main(int argc, char** argv) {
       if (!whole(record_min)) return 2;
     } else if (option == "--record-law") {
       record_path = argv[2];
+    } else if (option == "--wind") {
+      char* end = nullptr;
+      wind_v0 = std::strtod(argv[2], &end);
+      if (*argv[2] == '\0' || *end != '\0' || !acceptable_wind_speed(wind_v0) || wind_v0 == 0) {
+        std::fprintf(stderr, "aloft_step_profile: --wind takes a speed v0 in m/s, above 0 and at most %g, not '%s'\n",
+                     kFastestWind, argv[2]);
+        return 2;
+      }
     } else {
       std::fprintf(stderr, "aloft_step_profile: unknown option '%s'\n", option.c_str());
       return 2;
@@ -141,7 +181,7 @@ int main(int argc, char** argv) {
   if (argc < 3) {
     std::fprintf(stderr,
                  "usage: aloft_step_profile [--every N] [--record-law FILE [--record-every N] [--record-min M]] "
-                 "MOBILE(.json or component count) STEPS [collisions 0|1] [breeze|swinging[:SEED]] "
+                 "[--wind V0] MOBILE(.json or component count) STEPS [collisions 0|1] [rest|breeze|swinging[:SEED]] "
                  "[joint tolerance, m]\n");
     return 2;
   }
@@ -159,12 +199,15 @@ int main(int argc, char** argv) {
     seed = std::strtoul(digits.c_str(), &end, 10);
     seed_ok = !digits.empty() && *end == '\0' && start_from == "swinging";
   }
-  if ((start_from != "breeze" && start_from != "swinging") || !seed_ok) {
-    std::fprintf(stderr, "aloft_step_profile: the start is 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole number), not '%s'\n",
+  if ((start_from != "rest" && start_from != "breeze" && start_from != "swinging") || !seed_ok) {
+    std::fprintf(stderr,
+                 "aloft_step_profile: the start is 'rest', 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole "
+                 "number), not '%s'\n",
                  start.c_str());
     return 2;
   }
   const bool swinging = start_from == "swinging";
+  const bool breeze = start_from == "breeze";
   const double joint_tolerance = argc > 5 ? std::atof(argv[5]) : 0.0;
   if (!(joint_tolerance >= 0)) {
     std::fprintf(stderr, "aloft_step_profile: the joint tolerance is a length >= 0 (m), not '%s'\n", argv[5]);
@@ -179,14 +222,21 @@ int main(int argc, char** argv) {
     }
     Simulation sim(model, swinging ? swinging_state(model, 0.5, seed) : rest_state(model));
     sim.set_collisions(collisions);
-    if (swinging) {
-      if (!sim.step()) throw std::runtime_error(sim.failure()->message);
-    } else {
+    if (breeze) {
       set_breeze(model, sim.loads());  // as `aloft bench`
       for (int k = 0; k < 300; ++k)
         if (!sim.step()) throw std::runtime_error(sim.failure()->message);
       sim.loads().clear();
     }
+    std::unique_ptr<TimedWind> wind;
+    if (wind_v0 > 0) {
+      wind = std::make_unique<TimedWind>();
+      wind->wind = std::make_unique<Wind>(
+          model, source_facing_mobile(model, rest_state(model), Vec3(0, 0, -1), 1.5, 1.0), WindSettings{});
+      wind->v0 = wind_v0;
+    }
+    if (!breeze && !take_step(sim, wind.get()))  // the first factorization (the wind's first step, if any)
+      throw std::runtime_error(sim.failure()->message);
     sim.set_joint_tolerance(joint_tolerance);
     // The timed steps' contact-law solves, every record_every-th of those with at least record_min
     // contacts, written to record_path (the copies and the writing are timed with the steps).
@@ -212,8 +262,9 @@ int main(int argc, char** argv) {
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
       const double start = thread_seconds();
-      if (!timed_steps(sim, block)) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = thread_seconds() - start;
+      const double wind_start = wind ? wind->seconds : 0.0;
+      if (!timed_steps(sim, block, wind.get())) throw std::runtime_error(sim.failure()->message);
+      const double block_seconds = thread_seconds() - start - (wind ? wind->seconds - wind_start : 0.0);
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping
@@ -246,6 +297,10 @@ int main(int argc, char** argv) {
                 what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
                 (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
     print_rates("  ", before, counts_of(sim), steps);
+    if (wind)
+      std::printf("  wind: v0 = %g m/s; its occlusion refreshes and loads took %.3f us per step, left out of the "
+                  "figures above\n",
+                  wind->v0, 1e6 * wind->seconds / wind->steps_taken);
     if (!record_path.empty()) {
       record_file.close();
       if (!record_file) throw std::runtime_error("could not finish writing " + record_path);
