@@ -4,8 +4,8 @@
 
 #include <cstdio>
 #include <functional>
-#include <stdexcept>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 

@@ -47,7 +47,7 @@ CLI::Validator non_negative() {
       "");
 }
 
-// A steady wind speed v0 (m/s) the cone model takes (aloft/wind.hpp: kFastestWind).
+// A steady wind speed v0 (m/s) the cone model takes (aloft/spec.hpp: kFastestWind).
 CLI::Validator wind_speed() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
