@@ -15,50 +15,11 @@
 #include "aloft/render/renderer.hpp"
 #include "aloft/simulation.hpp"
 #include "common.hpp"
+#include "progress.hpp"
 #include "view/camera_flags.hpp"
 #include "wind_options.hpp"
 
 namespace aloft::cli {
-
-namespace {
-
-// A progress bar on stderr: redrawn in place on a terminal, a line per 10 % otherwise.
-class RenderProgress {
- public:
-  RenderProgress(bool enabled, long long total) : enabled_(enabled), total_(total), tty_(is_terminal(stderr)) {}
-  void update(long long done) {
-    if (!enabled_ || total_ <= 1) return;
-    const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-    if (tty_) {
-      constexpr int kWidth = 30;
-      const int filled = static_cast<int>(fraction * kWidth);
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-      const double left = done > 0 ? elapsed * static_cast<double>(total_ - done) / static_cast<double>(done) : 0;
-      std::fprintf(stderr, "\r  rendering [%.*s%*s] %3.0f%%  frame %lld/%lld  %.0f s left ", filled,
-                   "##############################", kWidth - filled, "", fraction * 100, done, total_, left);
-      std::fflush(stderr);
-      shown_ = true;
-    } else {
-      const int decile = static_cast<int>(fraction * 10);
-      if (decile <= decile_) return;
-      decile_ = decile;
-      std::fprintf(stderr, "aloft: rendering: %d%% (frame %lld of %lld)\n", decile * 10, done, total_);
-    }
-  }
-  void finish() {
-    if (shown_) std::fprintf(stderr, "\r%*s\r", 78, "");
-  }
-
- private:
-  bool enabled_;
-  long long total_;
-  bool tty_;
-  int decile_ = 0;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
-
-}  // namespace
 
 Runner add_render(CLI::App& app) {
   struct Options {
@@ -99,7 +60,7 @@ Runner add_render(CLI::App& app) {
   sub->add_flag("--no-shadows", o->no_shadows, "Draw without shadows");
   sub->add_flag("--glow-touching", o->glow_touching,
                 "Draw the pieces that touched another since the frame before (within 1/fps s) with a warm glow");
-  sub->add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress line and no summary");
   o->camera.add_to(sub);
   add_wind_options(sub, o->wind);
   sub->footer(
@@ -155,7 +116,7 @@ Runner add_render(CLI::App& app) {
     render::FrameSink sink(o->out, o->width, o->height, o->fps);
     const long long frames = sink.wants_every_frame() ? std::max(1LL, std::llround(o->duration * o->fps)) : 1;
     std::vector<std::uint8_t> pixels;
-    RenderProgress progress(!o->quiet, frames);
+    ProgressReport progress(!o->quiet, frames, "rendering", 0.0);
     const auto start = std::chrono::steady_clock::now();
     const auto draw_frame = [&] {
       if (o->glow_touching) {
@@ -186,7 +147,7 @@ Runner add_render(CLI::App& app) {
           return kExitSimulation;
         }
         draw_frame();
-        progress.update(k + 1);
+        if (progress.due(k + 1)) progress.show(k + 1, format("frame %lld of %lld", k + 1, frames));
       }
     }
     progress.finish();

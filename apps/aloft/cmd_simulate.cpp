@@ -15,6 +15,7 @@
 #include "aloft/simulation.hpp"
 #include "common.hpp"
 #include "contact_report.hpp"
+#include "progress.hpp"
 #include "wind_options.hpp"
 
 namespace aloft::cli {
@@ -81,48 +82,6 @@ class Trajectory {
   std::string buffer_;
 };
 
-// A progress line on stderr for runs longer than about 2 s: rewritten in place a few times a second on a
-// terminal, otherwise one line per 10 %.
-class Progress {
- public:
-  Progress(bool enabled, long long total) : enabled_(enabled), total_(total), tty_(is_terminal(stderr)) {}
-
-  void update(long long done, double sim_time) {
-    if (!enabled_ || total_ <= 0) return;
-    const double elapsed = seconds_since(start_);
-    if (elapsed < 2.0) return;
-    const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-    if (tty_) {
-      if (elapsed - last_ < 0.25) return;
-      last_ = elapsed;
-      const double rate = static_cast<double>(done) / elapsed;
-      const double left = rate > 0 ? static_cast<double>(total_ - done) / rate : 0;
-      std::fprintf(stderr, "\r  simulating: %3.0f%%  t = %.3f s  %.0f steps/s  %.0f s left   ", fraction * 100,
-                   sim_time, rate, left);
-      std::fflush(stderr);
-      shown_ = true;
-    } else {
-      const int decile = static_cast<int>(fraction * 10);
-      if (decile <= decile_) return;
-      decile_ = decile;
-      std::fprintf(stderr, "aloft: simulating: %d%% (t = %.3f s, %.0f s elapsed)\n", decile * 10, sim_time, elapsed);
-    }
-  }
-
-  void finish() {
-    if (shown_) std::fprintf(stderr, "\r%*s\r", 72, "");
-    shown_ = false;
-  }
-
- private:
-  bool enabled_;
-  long long total_;
-  bool tty_;
-  Clock::time_point start_ = Clock::now();
-  double last_ = -1;
-  int decile_ = 0;
-  bool shown_ = false;
-};
 
 }  // namespace
 
@@ -219,7 +178,8 @@ Runner add_simulate(CLI::App& app) {
     double peak_kinetic = 0;
     if (csv) csv->frame(sim.state());
 
-    Progress progress(!o->quiet, steps);
+    // Shown for runs longer than about 2 s.
+    ProgressReport progress(!o->quiet, steps, "simulating", 2.0);
     const auto start = Clock::now();
     bool ok = true;
     long long done = 0;
@@ -241,7 +201,8 @@ Runner add_simulate(CLI::App& app) {
           largest_turn = std::max(largest_turn, s.orientation[c].angularDistance(rest.orientation[c]));
         }
       }
-      if ((done & 63) == 0) progress.update(done, sim.state().time);
+      if ((done & 63) == 0 && progress.due(done))
+        progress.show(done, format("t = %.3f s, %.0f steps/s", sim.state().time, done / progress.elapsed()));
     }
     const double wall = seconds_since(start);
     progress.finish();

@@ -206,11 +206,15 @@ TEST_F(Viewer, HeadlessRenderWritesVideosOfTheRightLengthAndSize) {
   r = render(preset("southern-cross.json") + " --duration 0.4 --fps 10 --width 120 --height 80 --out clip.gif -q");
   ASSERT_EQ(r.code, 0);
   EXPECT_EQ(probe(dir_ / "clip.gif"), "120,80,4");
-  r = render(preset("steel-fish.json") + " --duration 0.3 --fps 10 --width 64 --height 48 --out frames/ -q");
+  // Without -q, and not on a terminal: a progress line per tenth of the frames (here per frame).
+  r = render(preset("steel-fish.json") + " --duration 0.3 --fps 10 --width 64 --height 48 --out frames/ 2> progress.txt");
   ASSERT_EQ(r.code, 0);
   int pngs = 0;
   for (const auto& e : fs::directory_iterator(dir_ / "frames")) pngs += e.path().extension() == ".png";
   EXPECT_EQ(pngs, 3);
+  const std::string progress = read(dir_ / "progress.txt");
+  EXPECT_NE(progress.find("aloft: rendering: 33% (frame 1 of 3, "), std::string::npos) << progress;
+  EXPECT_NE(progress.find("aloft: rendering: 100% (frame 3 of 3, "), std::string::npos) << progress;
 }
 
 TEST_F(Viewer, HeadlessRenderPngShowsTheMobile) {
