@@ -107,7 +107,8 @@ std::string profile_text(const WindProfileSpec& p) {
 
 void add_wind_options(CLI::App* sub, WindOptions& o) {
   const char* group = "Wind (the paper's cone; see docs/wind.md)";
-  auto* constant = sub->add_option("--wind", o.constant, "Blow a steady wind: speed v0 at the source disc S0 (m/s, 0 to 100)")
+  auto* constant = sub->add_option("--wind", o.constant,
+                                   "Blow a steady wind: speed v0 at the source disc S0 (m/s, 0 to 100)")
                        ->type_name("V0")
                        ->check(wind_speed())
                        ->group(group);

@@ -151,9 +151,9 @@ struct MobileSpec {
 
 // Parse a mobile file. Throws InputError (file, JSON path, line, problem) for unreadable files, JSON
 // syntax errors, missing or unknown keys, wrong types, non-finite or non-positive sizes, bad colours,
-// bad wind sources (from == to, r0 or l0 not positive, a speed outside 0 to kFastestWind, a profile out of range) or camera
-// values out of range, malformed or missing OBJ meshes (paths relative to the mobile file). Meaning across components
-// (parents, cycles, the fixed component, balance) is compile()'s job.
+// bad wind sources (from == to, r0 or l0 not positive, a speed outside 0 to kFastestWind, a profile out
+// of range) or camera values out of range, malformed or missing OBJ meshes (paths relative to the mobile
+// file). Meaning across components (parents, cycles, the fixed component, balance) is compile()'s job.
 MobileSpec parse_mobile_file(const std::string& path);
 
 // The same for text already in memory; `file` names it in messages, `base_dir` resolves mesh paths.

@@ -32,7 +32,7 @@ void EnvelopeSettings::validate() const {
   require(std::isfinite(calibration_s) && calibration_s >= 0 && calibration_s <= 60,
           "the noise calibration must last 0 to 60 s");
   require(std::isfinite(noise_floor) && noise_floor <= 1, "the noise floor must be an RMS <= 1 (or < 0: calibrate)");
-  require(max_v0 > 0 && acceptable_wind_speed(max_v0), "the largest v0 must be > 0 m/s and at most kFastestWind");
+  require(max_v0 > 0 && acceptable_wind_speed(max_v0), "the largest v0 must be > 0 m/s and at most 100 m/s (kFastestWind)");
 }
 
 EnvelopeFollower::EnvelopeFollower(int sample_rate, const EnvelopeSettings& settings)

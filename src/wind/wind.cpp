@@ -88,7 +88,8 @@ Wind::Wind(const Model& model, const WindSource& source, const WindSettings& set
         const double offset = n.dot(a);
         int plane = -1;
         for (std::size_t p = first_own_plane; p < plane_normals.size() && plane < 0; ++p)
-          if (plane_is_round[p] == is_round && (plane_normals[p] - n).norm() < kSamePlane && std::abs(plane_offsets[p] - offset) < kSamePlane)
+          if (plane_is_round[p] == is_round && (plane_normals[p] - n).norm() < kSamePlane &&
+              std::abs(plane_offsets[p] - offset) < kSamePlane)
             plane = static_cast<int>(p);
         if (plane < 0) {
           plane = static_cast<int>(plane_normals.size());
