@@ -37,7 +37,6 @@
 // of the (sub)steps taken.
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -67,21 +66,18 @@ struct TimedWind {
   std::unique_ptr<aloft::Wind> wind;
   double v0 = 0;              // m/s at S0
   long steps_taken = 0;       // steps blown so far (the refresh schedule)
-  double seconds = 0;         // time spent in the wind's refresh and apply, s
+  aloft::ApartTimer timer;    // the wind's refresh and apply, timed apart from the steps
   static constexpr int kRefreshEvery = 17;
 };
 
 // One step of the run: the wind's loads first (timed apart), when there is a wind.
 bool take_step(aloft::Simulation& sim, TimedWind* wind) {
   if (wind) {
-    // The steady clock, not the thread's CPU clock: that one is a system call here (about 1.6 us, as much
-    // as a Steel Fish step), the steady clock's a read of memory (vDSO). On a thread that does not wait,
-    // both count the same time.
-    const auto start = std::chrono::steady_clock::now();
-    if (wind->steps_taken++ % TimedWind::kRefreshEvery == 0) wind->wind->refresh_occlusion(sim.state());
-    sim.loads().clear();
-    wind->wind->apply(sim.state(), wind->v0, sim.timestep(), sim.loads());
-    wind->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    wind->timer.apart([&] {
+      if (wind->steps_taken++ % TimedWind::kRefreshEvery == 0) wind->wind->refresh_occlusion(sim.state());
+      sim.loads().clear();
+      wind->wind->apply(sim.state(), wind->v0, sim.timestep(), sim.loads());
+    });
   }
   return sim.step();
 }
@@ -266,9 +262,9 @@ int main(int argc, char** argv) {
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
       const double start = thread_seconds();
-      const double wind_start = wind ? wind->seconds : 0.0;
+      const double wind_start = wind ? wind->timer.taken_from_span() : 0.0;
       if (!timed_steps(sim, block, wind.get())) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = thread_seconds() - start - (wind ? wind->seconds - wind_start : 0.0);
+      const double block_seconds = thread_seconds() - start - (wind ? wind->timer.taken_from_span() - wind_start : 0.0);
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping
@@ -304,7 +300,7 @@ int main(int argc, char** argv) {
     if (wind)
       std::printf("  wind: v0 = %g m/s; its occlusion refreshes and loads took %.3f us per step, left out of the "
                   "figures above\n",
-                  wind->v0, 1e6 * wind->seconds / wind->steps_taken);
+                  wind->v0, 1e6 * wind->timer.work_seconds() / wind->steps_taken);
     if (!record_path.empty()) {
       record_file.close();
       if (!record_file) throw std::runtime_error("could not finish writing " + record_path);

@@ -8,7 +8,8 @@
 // CPU time). The two runs still part from there: without collisions the pieces pass through each other
 // and keep the energy the knocks would take (the footer below says so to the user). With --start
 // swinging:SEED --repetitions 1 --steps N the collisions-on over collisions-off ratio is issue 3's
-// measure, BM_StepSpan's, for that start and span.
+// measure, BM_StepSpan's, for that start and span. With --wind V0 (and --start rest) the steps are timed
+// in the paper's wind, the wind's own work left out: the mobile as it moves in its main use.
 
 #include <algorithm>
 #include <charconv>
@@ -27,6 +28,7 @@
 #include "aloft/state.hpp"
 #include "aloft/thread_clock.hpp"
 #include "common.hpp"
+#include "wind_options.hpp"
 
 #ifndef ALOFT_BUILD_TYPE
 #define ALOFT_BUILD_TYPE "unknown"
@@ -70,25 +72,36 @@ std::string failure_of(const Simulation& sim) {
 // A count, not a time, so that every machine times the same motion.
 constexpr int kBreezeSteps = 300;
 
-// Where both timed runs of a mobile start (--start): after the breeze (the default), or from the
-// benchmarks' swinging state of `seed` (swinging_state, max rate 0.5 rad/s, as BM_StepSpan).
+// Where both timed runs of a mobile start (--start): after the breeze (the default), from the
+// benchmarks' swinging state of `seed` (swinging_state, max rate 0.5 rad/s, as BM_StepSpan), or from the
+// designed pose at rest (for --wind, which then sets the mobile moving).
 struct BenchStart {
-  bool swinging = false;
+  enum class From { kBreeze, kSwinging, kRest };
+  From from = From::kBreeze;
   std::uint64_t seed = 7;  // swinging_state's default, BM_StepSpan's start
 
   std::string describe() const {
-    return swinging ? format("the swinging state of seed %llu (as BM_StepSpan)", static_cast<unsigned long long>(seed))
-                    : format("%d steps of a breeze with collisions on", kBreezeSteps);
+    switch (from) {
+      case From::kSwinging:
+        return format("the swinging state of seed %llu (as BM_StepSpan)", static_cast<unsigned long long>(seed));
+      case From::kRest:
+        return "the designed pose at rest";
+      case From::kBreeze:
+        break;
+    }
+    return format("%d steps of a breeze with collisions on", kBreezeSteps);
   }
 };
 
-// "breeze", "swinging" or "swinging:SEED" (SEED a whole number); empty if the text is none of these.
+// "breeze", "rest", "swinging" or "swinging:SEED" (SEED a whole number); empty if the text is none of
+// these.
 std::optional<BenchStart> parse_start(const std::string& text) {
   if (text == "breeze") return BenchStart{};
-  if (text == "swinging") return BenchStart{true};
+  if (text == "rest") return BenchStart{BenchStart::From::kRest};
+  if (text == "swinging") return BenchStart{BenchStart::From::kSwinging};
   const std::string prefix = "swinging:";
   if (text.rfind(prefix, 0) != 0 || text.size() == prefix.size()) return std::nullopt;
-  BenchStart start{true};
+  BenchStart start{BenchStart::From::kSwinging};
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data() + prefix.size(), end, start.seed);
   if (ec != std::errc() || ptr != end) return std::nullopt;
@@ -119,10 +132,39 @@ std::optional<State> breeze_start(const Model& model, const std::string& name, s
 }
 
 // The timing both ways: `repetitions` runs of `fixed_steps` steps each (or, if it is 0, enough for 0.5 s),
-// one after another from the start; the median rate is reported.
+// one after another from the start; the median rate is reported. With a wind (v0 > 0, m/s) every step
+// is blown by it, placed as `aloft simulate --wind V0` places it, and its own work (occlusion and loads)
+// is left out of the figures.
 struct Timing {
   long long fixed_steps = 0;
   int repetitions = 5;
+  double wind = 0;
+};
+
+// The steps of a measurement: each blown by the wind first, if there is one, timed apart (`wind`: what a
+// span of steps gives up for it).
+class BlownSteps {
+ public:
+  BlownSteps(const Model& model, Simulation& sim, double v0) : sim_(sim) {
+    if (!(v0 > 0)) return;
+    WindOptions options;
+    options.constant = v0;
+    options.no_file_wind = true;
+    wind_ = std::make_unique<WindSet>(model, MobileSpec{}, sim.state(), options, sim.timestep());
+    timer_ = std::make_unique<ApartTimer>();
+  }
+  bool step() {
+    if (wind_) timer_->apart([&] { wind_->apply(steps_++, sim_.state(), sim_.timestep(), sim_.loads()); });
+    return sim_.step();
+  }
+  // The CPU time (s) a span of steps gives up for the wind so far (none without a wind).
+  double wind_seconds() const { return timer_ ? timer_->taken_from_span() : 0.0; }
+
+ private:
+  Simulation& sim_;
+  std::unique_ptr<WindSet> wind_;
+  std::unique_ptr<ApartTimer> timer_;  // made with the wind (it calibrates the clock's cost, 8 ms)
+  long long steps_ = 0;
 };
 
 Measurement measure(const Model& model, const State& start, const Timing& timing, bool collisions) {
@@ -130,19 +172,22 @@ Measurement measure(const Model& model, const State& start, const Timing& timing
   Measurement out;
   Simulation sim(model, start);
   sim.set_collisions(collisions);
+  BlownSteps blown(model, sim, timing.wind);
   out.steps_per_repetition = fixed_steps;
   if (fixed_steps <= 0) {
     // Enough steps for 0.5 s at the rate of a few calibration steps (re-measured below if the first
     // repetition is much shorter).
     constexpr long long kCalibrationSteps = 3;
     const double calibration_start = thread_seconds();
+    const double calibration_wind = blown.wind_seconds();
     for (long long s = 0; s < kCalibrationSteps; ++s) {
-      if (!sim.step()) {
+      if (!blown.step()) {
         out.failure = failure_of(sim);
         return out;
       }
     }
-    const double rate = static_cast<double>(kCalibrationSteps) / std::max(seconds_since(calibration_start), 1e-9);
+    const double rate = static_cast<double>(kCalibrationSteps) /
+                        std::max(seconds_since(calibration_start) - (blown.wind_seconds() - calibration_wind), 1e-9);
     out.steps_per_repetition = std::max(3LL, static_cast<long long>(std::ceil(0.5 * rate)));
   }
 
@@ -152,13 +197,15 @@ Measurement measure(const Model& model, const State& start, const Timing& timing
   const long long steps_before = sim.step_count();
   for (int r = 0; r < timing.repetitions; ++r) {
     const double repetition_start = thread_seconds();
+    const double repetition_wind = blown.wind_seconds();
     for (long long s = 0; s < out.steps_per_repetition; ++s) {
-      if (!sim.step()) {
+      if (!blown.step()) {
         out.failure = failure_of(sim);
         return out;
       }
     }
-    const double elapsed = std::max(seconds_since(repetition_start), 1e-9);
+    const double elapsed =
+        std::max(seconds_since(repetition_start) - (blown.wind_seconds() - repetition_wind), 1e-9);
     rates.push_back(static_cast<double>(out.steps_per_repetition) / elapsed);
     // Keep a too-short calibration from making the repetitions short: re-measure at >= 0.5 s.
     if (r == 0 && fixed_steps <= 0 && elapsed < 0.4) {
@@ -200,8 +247,9 @@ void print_row(const std::string& name, int components, const Measurement& free,
 // Sets the mobile swinging, times it both ways from there and prints its line.
 void bench_mobile(const Model& model, const std::string& name, const BenchStart& how, const Timing& timing) {
   std::string failure;
-  const std::optional<State> start =
-      how.swinging ? std::optional<State>(swinging_state(model, 0.5, how.seed)) : breeze_start(model, name, failure);
+  const std::optional<State> start = how.from == BenchStart::From::kSwinging ? swinging_state(model, 0.5, how.seed)
+                                     : how.from == BenchStart::From::kRest   ? rest_state(model)
+                                                                              : breeze_start(model, name, failure);
   if (!start) {
     std::printf("%-20s %6d  failed: %s\n", name.c_str(), model.count, failure.c_str());
     std::fflush(stdout);
@@ -219,6 +267,7 @@ Runner add_bench(CLI::App& app) {
     std::vector<int> sizes{15, 127, 1023, 8191, 65535};
     std::string presets;
     std::string start = "breeze";
+    double wind = 0;
   };
   auto o = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -231,16 +280,23 @@ Runner add_bench(CLI::App& app) {
       ->type_name("R")
       ->check(integer_in(1, 1000));
   sub->add_option("--start", o->start,
-                  "Where both runs start: 'breeze' (default: 300 steps of a 0.2 g breeze, collisions on), or "
-                  "'swinging' / 'swinging:SEED' (the benchmarks' swinging state; seed 7 if not given)")
+                  "Where both runs start: 'breeze' (default: 300 steps of a 0.2 g breeze, collisions on), "
+                  "'swinging' / 'swinging:SEED' (the benchmarks' swinging state; seed 7 if not given), or 'rest' "
+                  "(the designed pose)")
       ->type_name("FROM")
       ->check(CLI::Validator(
           [](std::string& input) -> std::string {
             return parse_start(input) ? std::string()
-                                      : "must be 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole number), got \"" +
+                                      : "must be 'breeze', 'rest', 'swinging' or 'swinging:SEED' (SEED a whole "
+                                        "number), got \"" +
                                             input + "\"";
           },
           ""));
+  sub->add_option("--wind", o->wind,
+                  "Blow every timed step with a steady wind, speed v0 at S0 (m/s, 0 to 100), placed as by "
+                  "'aloft simulate --wind'; the wind's own work is left out of the figures (default: none)")
+      ->type_name("V0")
+      ->check(wind_speed());
   sub->add_option("--sizes", o->sizes, "Sizes (components, hook included) of the generated mobiles, comma-separated (each >= 2; default 15,127,1023,8191,65535)")
       ->type_name("N,...")
       ->delimiter(',')
@@ -264,22 +320,29 @@ Runner add_bench(CLI::App& app) {
       "measure. That is the benchmarks' BM_StepSpan: one span from the swinging state, timed whole, e.g.\n"
       "5000 steps at 1023 components (docs/performance.md); --start swinging:SEED --repetitions 1\n"
       "--steps N gives it for one start.\n"
+      "With --wind V0 every timed step is blown by a steady wind placed as 'aloft simulate --wind V0' places\n"
+      "it; the wind's own work (occlusion and loads, timed apart by the same clock) is left out, what it\n"
+      "costs the step (its data pushed out of the caches) is not. With --start rest the wind alone sets\n"
+      "the mobile moving, as in its main use.\n"
       "\n"
       "Examples:\n"
       "  aloft bench\n"
       "  aloft bench --sizes 15,127 --steps 2000\n"
       "  aloft bench --presets ~/aloft/mobiles --sizes 1023\n"
-      "  aloft bench --sizes 1023 --start swinging:1 --repetitions 1 --steps 5000   # issue 3's measure\n");
+      "  aloft bench --sizes 1023 --start swinging:1 --repetitions 1 --steps 5000   # issue 3's measure\n"
+      "  aloft bench --sizes 127,1023 --start rest --wind 3 --repetitions 1 --steps 3000   # in a breath\n");
   return [o] {
     namespace fs = std::filesystem;
     const BenchStart start = *parse_start(o->start);  // checked by the option's validator
-    const Timing timing{o->steps, o->repetitions};
+    const Timing timing{o->steps, o->repetitions, o->wind};
     const std::string dir = o->presets.empty() ? (fs::path(source_dir()) / "mobiles").string() : o->presets;
     std::printf("aloft bench: %s, %u cores; build %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
                 ALOFT_BUILD_TYPE);
-    std::printf("thread CPU time, median of %d repetition%s of %s; both columns from the same start,\n%s\n\n",
+    std::printf("thread CPU time, median of %d repetition%s of %s; both columns from the same start,\n%s%s\n\n",
                 timing.repetitions, timing.repetitions == 1 ? "" : "s",
-                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", start.describe().c_str());
+                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", start.describe().c_str(),
+                timing.wind > 0 ? format(", in a steady wind of v0 = %g m/s (its own work left out)", timing.wind).c_str()
+                                : "");
     std::printf("%-27s %-46s | %s\n", "", "collisions off (issue 2)", "collisions on (issue 3)");
     std::printf("%-20s %6s %11s %10s %8s %6s %6s | %10s %8s %6s %6s\n", "mobile", "comps", "steps/s", "us/step",
                 "us/comp", "halv", "solves", "us/step", "us/comp", "halv", "ratio");

@@ -47,7 +47,8 @@ CLI::Validator non_negative() {
       "");
 }
 
-// A steady wind speed v0 (m/s) the cone model takes (aloft/spec.hpp: kFastestWind).
+}  // namespace
+
 CLI::Validator wind_speed() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
@@ -57,6 +58,8 @@ CLI::Validator wind_speed() {
       },
       "");
 }
+
+namespace {
 
 // Centre and radius (m) of a sphere around the whole mobile at `state`.
 std::pair<Vec3, double> mobile_sphere(const Model& model, const State& state) {

@@ -6,7 +6,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-
 #include <vector>
 
 #include "aloft/audio.hpp"
@@ -38,6 +37,8 @@ struct WindOptions {
 };
 
 void add_wind_options(CLI::App* sub, WindOptions& o);
+// A steady wind speed v0 (m/s) the cone model takes (aloft/spec.hpp: kFastestWind), as --wind checks it.
+CLI::Validator wind_speed();
 // Only --no-file-wind (for `aloft view`, whose own wind has other controls).
 void add_no_file_wind_flag(CLI::App* sub, bool& no_file_wind);
 

@@ -376,8 +376,32 @@ TEST_F(Cli, BenchStartsFromTheSwingingStateOfTheSeedGiven) {
   for (const char* bad : {"swinging:x", "swinging:", "swing", "swinging:-1"}) {
     const Result r = aloft(std::string("bench --start ") + bad);
     EXPECT_EQ(r.code, 2) << bad;
-    EXPECT_NE(r.err.find("--start: must be 'breeze', 'swinging' or 'swinging:SEED'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--start: must be 'breeze', 'rest', 'swinging' or 'swinging:SEED'"), std::string::npos)
+        << r.err;
   }
+}
+
+// From rest a balanced mobile stays still: one tree solve per step (the velocity projection) and no
+// halving. In a wind (placed as `aloft simulate --wind` places it) it moves, and the joints need Newton
+// corrections: more solves per step.
+TEST_F(Cli, BenchTimesTheStepsInAWindFromRest) {
+  const std::string args = "bench --sizes 127 --steps 300 --repetitions 1 --presets no-such-dir --start rest";
+  const Result still = aloft(args), blown = aloft(args + " --wind 3");
+  ASSERT_EQ(still.code, 0) << still.err;
+  ASSERT_EQ(blown.code, 0) << blown.err;
+  EXPECT_NE(still.out.find("the designed pose at rest\n"), std::string::npos) << still.out;
+  EXPECT_NE(blown.out.find("the designed pose at rest, in a steady wind of v0 = 3 m/s (its own work left out)"),
+            std::string::npos)
+      << blown.out;
+  const std::vector<std::string> at_rest = bench_counts(still.out), in_wind = bench_counts(blown.out);
+  ASSERT_EQ(at_rest.size(), 3u) << still.out;
+  ASSERT_EQ(in_wind.size(), 3u) << blown.out;
+  EXPECT_EQ(at_rest[0], "0.00") << still.out;  // halvings
+  EXPECT_EQ(at_rest[1], "1.00") << still.out;  // tree solves per step
+  EXPECT_GT(std::stod(in_wind[1]), 1.1) << blown.out;
+  const Result too_fast = aloft("bench --wind 200");
+  EXPECT_EQ(too_fast.code, 2);
+  EXPECT_NE(too_fast.err.find("--wind: must be from 0 to 100 m/s"), std::string::npos) << too_fast.err;
 }
 
 }  // namespace
