@@ -141,8 +141,8 @@ struct Timing {
   double wind = 0;
 };
 
-// The steps of a measurement: each blown by the wind first, if there is one, timed apart (`wind`: what a
-// span of steps gives up for it).
+// The steps of a measurement: each blown by the wind first, if there is one, the wind's work timed apart
+// (wind_seconds: what a span of steps gives up for it).
 class BlownSteps {
  public:
   BlownSteps(const Model& model, Simulation& sim, double v0) : sim_(sim) {
