@@ -82,7 +82,6 @@ class Trajectory {
   std::string buffer_;
 };
 
-
 }  // namespace
 
 Runner add_simulate(CLI::App& app) {
