@@ -399,7 +399,7 @@ TEST_F(Cli, BenchTimesTheStepsInAWindFromRest) {
   EXPECT_EQ(at_rest[0], "0.00") << still.out;  // halvings
   EXPECT_EQ(at_rest[1], "1.00") << still.out;  // tree solves per step
   EXPECT_GT(std::stod(in_wind[1]), 1.1) << blown.out;
-  const Result too_fast = aloft("bench --wind 200");
+  const Result too_fast = aloft("bench --sizes 15 --steps 10 --repetitions 1 --presets no-such-dir --wind 200");
   EXPECT_EQ(too_fast.code, 2);
   EXPECT_NE(too_fast.err.find("--wind: must be from 0 to 100 m/s"), std::string::npos) << too_fast.err;
 }
