@@ -125,7 +125,7 @@ Runner add_mic(CLI::App& app) {
         last_line = t;
       }
       if (o->duration > 0 && t >= o->duration) break;
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double wall = seconds_since(start);
       if (o->duration > 0 && wall > o->duration + 5) {
         std::fprintf(stderr, "%saloft: the device stopped sending sound after %.2f s of audio\n", tty ? "\n" : "", t);
         break;

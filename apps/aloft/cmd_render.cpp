@@ -152,7 +152,7 @@ Runner add_render(CLI::App& app) {
     }
     progress.finish();
     const std::string written = sink.finish();
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double wall = seconds_since(start);
     if (!o->quiet) {
       std::printf("mobile     %s\n", model.name.c_str());
       for (const WindDriver& d : wind.drivers()) std::printf("wind       %s\n", d.description.c_str());

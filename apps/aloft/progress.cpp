@@ -25,9 +25,7 @@ ProgressReport::ProgressReport(bool enabled, long long total, std::string verb, 
       quiet_seconds_(quiet_seconds),
       terminal_(is_terminal(stderr)) {}
 
-double ProgressReport::elapsed() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
+double ProgressReport::elapsed() const { return seconds_since(start_); }
 
 bool ProgressReport::due(long long done) const {
   if (!enabled_) return false;

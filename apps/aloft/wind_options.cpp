@@ -291,7 +291,7 @@ void WindSet::apply(long long step, const State& state, double h, ExternalLoads&
     if (step % d.refresh_every == 0) {
       const auto t0 = std::chrono::steady_clock::now();
       d.wind->refresh_occlusion(state);
-      occlusion_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      occlusion_seconds_ += seconds_since(t0);
       ++refreshes_;
       elements_ += d.wind->elements().size();
     }

@@ -54,7 +54,6 @@ class ApartTimer {
   double taken_from_span() const { return seconds_ + static_cast<double>(count_) * read_cost_; }
   // The work's own time (s), the reads' cost taken out (one read's cost falls inside each interval).
   double work_seconds() const { return seconds_ - static_cast<double>(count_) * read_cost_; }
-  long long count() const { return count_; }
 
  private:
   double read_cost_;
