@@ -16,10 +16,12 @@ WorldBox empty_box() {
   return {Vec3::Constant(inf), Vec3::Constant(-inf)};
 }
 
-// Closed boxes: touching counts as overlapping (as the sweep and prune did).
+// Closed boxes: touching counts as overlapping (as the sweep and prune did). The six comparisons are
+// combined without branches (`|` of ints, not `||`): a pair's boxes overlap unpredictably.
 inline bool overlap(const WorldBox& a, const WorldBox& b) {
-  return !((a.low.x() > b.high.x()) | (b.low.x() > a.high.x()) | (a.low.y() > b.high.y()) |
-           (b.low.y() > a.high.y()) | (a.low.z() > b.high.z()) | (b.low.z() > a.high.z()));
+  const int apart = int{a.low.x() > b.high.x()} | int{b.low.x() > a.high.x()} | int{a.low.y() > b.high.y()} |
+                    int{b.low.y() > a.high.y()} | int{a.low.z() > b.high.z()} | int{b.low.z() > a.high.z()};
+  return apart == 0;
 }
 
 inline void emit(int a, int b, std::vector<std::pair<int, int>>& overlaps) {
