@@ -14,6 +14,7 @@
 
 #include "aloft/collision.hpp"
 #include "bench_models.hpp"
+#include "common/splitmix64.hpp"
 
 namespace {
 
@@ -26,12 +27,7 @@ constexpr double kTurn = 0.15;         // rad: largest joint turn of the displac
 // hook down: component i turns with its parent's accumulated rotation and then its own, about its joint.
 State displaced_state(const Model& model, double max_turn, std::uint64_t seed = 11) {
   std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 3;
-  auto unit = [&s] {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-  };
+  auto unit = [&s] { return splitmix64_unit(s); };
   State state = swinging_state(model);
   std::vector<Quat> turn(model.count, Quat::Identity());
   for (int i = 1; i < model.count; ++i) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "common/splitmix64.hpp"
+
 namespace aloft {
 
 State rest_state(const Model& model) {
@@ -18,13 +20,7 @@ State rest_state(const Model& model) {
 
 State swinging_state(const Model& model, double max_rate, std::uint64_t seed) {
   std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 1;
-  auto unit = [&s] {  // splitmix64 -> [0, 1)
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-53;
-  };
+  auto unit = [&s] { return splitmix64_unit(s); };
   State state = rest_state(model);
   for (int i = 1; i < model.count; ++i) {
     const double z = 2 * unit() - 1;

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "aloft/geometry.hpp"
+#include "common/splitmix64.hpp"
 #include "wind/item_rasterizer.hpp"
 
 namespace aloft {
@@ -35,16 +36,8 @@ Mat3 source_frame(const Vec3& direction) {
   return f;
 }
 
-// splitmix64: a small, well-mixed, portable generator (the same stream on every platform).
-std::uint64_t next_random(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 // Uniform in (0, 1].
-double next_uniform(std::uint64_t& state) { return (static_cast<double>(next_random(state) >> 11) + 1) * 0x1p-53; }
+double next_uniform(std::uint64_t& state) { return (static_cast<double>(splitmix64(state) >> 11) + 1) * 0x1p-53; }
 
 // Standard normal by Box-Muller (the cosine branch; portable, unlike std::normal_distribution).
 double next_normal(std::uint64_t& state) {
