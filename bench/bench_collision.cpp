@@ -34,11 +34,9 @@ State displaced_state(const Model& model, double max_turn, std::uint64_t seed = 
     const Vec3 axis = Vec3(2 * unit() - 1, 2 * unit() - 1, 2 * unit() - 1).normalized();
     const int p = model.parent[i];
     turn[i] = (turn[p] * Quat(Eigen::AngleAxisd(max_turn * unit(), axis))).normalized();
-    const Vec3 joint = p == 0 ? model.joint_world[i]
-                              : Vec3(state.position[p] + state.orientation[p] * model.joint_in_parent[i]);
     state.orientation[i] = (turn[i] * model.rest_orientation[i]).normalized();
-    state.position[i] = joint - state.orientation[i] * model.joint_in_child[i];
   }
+  place_on_joints(model, state);
   return state;
 }
 

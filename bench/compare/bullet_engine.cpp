@@ -134,10 +134,8 @@ class BulletEngine : public Engine {
       out.position[i] = out.position[p] + q * from_bt(body_->getRVector(link));
       const btScalar* qdot = body_->getJointVelMultiDof(link);
       out.angular[i] = out.angular[p] + q * Vec3(qdot[0], qdot[1], qdot[2]);
-      const Vec3 joint = out.position[i] + q * model_.joint_in_child[i];
-      out.velocity[i] = out.velocity[p] + out.angular[p].cross(joint - out.position[p]) +
-                        out.angular[i].cross(out.position[i] - joint);
     }
+    set_velocities_keeping_joints(model_, out);
   }
 
  private:

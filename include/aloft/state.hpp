@@ -28,6 +28,17 @@ State rest_state(const Model& model);
 // distributions.
 State swinging_state(const Model& model, double max_rate = 0.5, std::uint64_t seed = 7);
 
+// Puts every moving component where its joint holds at its orientation, from the hook down:
+// x_i = (joint i's point on the parent) - R_i c_i (c_i: the joint in the child's body frame, m).
+// Orientations are left as they are; afterwards max_joint_separation is round-off.
+void place_on_joints(const Model& model, State& state);
+
+// Sets every moving component's centre-of-mass velocity (world, m/s) so that its joint's point moves
+// alike on both sides, from its angular velocity and the parent's motion, from the hook down:
+// v_i = v_p + w_p x (j_i - x_p) + w_i x (x_i - j_i), j_i the joint's world point. Angular velocities
+// and positions are left as they are.
+void set_velocities_keeping_joints(const Model& model, State& state);
+
 // Energy (J) of a state: kinetic + gravitational potential (zero at the world origin).
 double kinetic_energy(const Model& model, const State& state);
 double potential_energy(const Model& model, const State& state);

@@ -29,13 +29,22 @@ State swinging_state(const Model& model, double max_rate, std::uint64_t seed) {
     const Vec3 axis(r * std::cos(phi), r * std::sin(phi), z);
     state.angular[i] = max_rate * (0.5 + 0.5 * unit()) * axis;
   }
-  for (int i = 1; i < model.count; ++i) {
+  set_velocities_keeping_joints(model, state);
+  return state;
+}
+
+void place_on_joints(const Model& model, State& state) {
+  for (int i = 1; i < model.count; ++i)  // parents come before their children
+    state.position[i] = joint_on_parent(model, state, i) - state.orientation[i] * model.joint_in_child[i];
+}
+
+void set_velocities_keeping_joints(const Model& model, State& state) {
+  for (int i = 1; i < model.count; ++i) {  // parents come before their children
     const int p = model.parent[i];
     const Vec3 joint = joint_on_child(model, state, i);
     state.velocity[i] = state.velocity[p] + state.angular[p].cross(joint - state.position[p]) +
                         state.angular[i].cross(state.position[i] - joint);
   }
-  return state;
 }
 
 double kinetic_energy(const Model& model, const State& state) {

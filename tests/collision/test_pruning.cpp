@@ -35,11 +35,9 @@ State random_pose(const Model& model, double max_turn, std::mt19937& rng) {
     const int p = model.parent[i];
     const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
     turn[i] = (turn[p] * Quat(Eigen::AngleAxisd(max_turn * 0.5 * (u(rng) + 1), axis))).normalized();
-    const Vec3 joint = p == 0 ? model.joint_world[i]
-                              : Vec3(state.position[p] + state.orientation[p] * model.joint_in_parent[i]);
     state.orientation[i] = (turn[i] * model.rest_orientation[i]).normalized();
-    state.position[i] = joint - state.orientation[i] * model.joint_in_child[i];
   }
+  place_on_joints(model, state);
   return state;
 }
 

@@ -44,6 +44,16 @@ void random_consistent_velocities(const Model& model, TreeSolver& solver, unsign
   }
 }
 
+// How fast joint i's two sides move apart (m/s): the velocity of its point on the child minus that on
+// the parent, with `pose`'s orientations and `moving`'s velocities (a solve's result).
+double joint_opening_speed(const Model& model, const State& pose, const State& moving, int i) {
+  const int p = model.parent[i];
+  const Vec3 r = pose.orientation[i] * model.joint_in_child[i];
+  const Vec3 s = pose.orientation[p] * model.joint_in_parent[i];
+  const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(moving.velocity[p] + moving.angular[p].cross(s));
+  return (moving.velocity[i] + moving.angular[i].cross(r) - vp).norm();
+}
+
 // A contact on body b (against a, possibly the fixed component 0) at a point near b, with a normal chosen
 // so that the two approach.
 Contact approaching_contact(const State& state, int a, int b, const Vec3& offset, const Vec3& direction) {
@@ -215,14 +225,8 @@ TEST(ContactResponse, NeverAddsEnergyStaysInTheConeAndKeepsJoints) {
       EXPECT_LE(P.segment<2>(3 * k + 1).norm(), mu * P[3 * k] * (1 + 1e-12) + 1e-15);
     }
     // The joints still move together: the impulse went through the joint rows too.
-    for (int i = 1; i < model.count; ++i) {
-      const int p = model.parent[i];
-      const Vec3 r = state.orientation[i] * model.joint_in_child[i];
-      const Vec3 s = state.orientation[p] * model.joint_in_parent[i];
-      const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(after.velocity[p] + after.angular[p].cross(s));
-      // Relative 1e-9 of O(1) velocities, the tree solve's accuracy.
-      EXPECT_LT((after.velocity[i] + after.angular[i].cross(r) - vp).norm(), 1e-9) << "seed " << seed << " joint " << i;
-    }
+    for (int i = 1; i < model.count; ++i)  // relative 1e-9 of O(1) velocities, the tree solve's accuracy
+      EXPECT_LT(joint_opening_speed(model, state, after, i), 1e-9) << "seed " << seed << " joint " << i;
   }
   EXPECT_GT(sliding, 5);  // the sliding branch was exercised
 }
@@ -356,13 +360,8 @@ TEST(ContactResponse, CorrectionStopsTheApproachKeepsTheJointsAndAddsNoEnergy) {
       // O(1) velocities) of no approach.
       EXPECT_GE(c.normal.dot(point_velocity(c.a) - point_velocity(c.b)), -1e-9) << "seed " << seed;
     }
-    for (int i = 1; i < model.count; ++i) {
-      const int p = model.parent[i];
-      const Vec3 r = state.orientation[i] * model.joint_in_child[i];
-      const Vec3 s = state.orientation[p] * model.joint_in_parent[i];
-      const Vec3 vp = p == 0 ? Vec3::Zero() : Vec3(pushed.velocity[p] + pushed.angular[p].cross(s));
-      EXPECT_LT((pushed.velocity[i] + pushed.angular[i].cross(r) - vp).norm(), 1e-9) << "seed " << seed;
-    }
+    for (int i = 1; i < model.count; ++i)
+      EXPECT_LT(joint_opening_speed(model, state, pushed, i), 1e-9) << "seed " << seed << " joint " << i;
     // A second look finds nothing more to do.
     EXPECT_FALSE(response.correct(1e-3, pushed.velocity, pushed.angular, tolerance)) << "seed " << seed;
   }

@@ -38,14 +38,7 @@ Swinging swinging_mobile(int components) {
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     s.angular[i] = 0.5 * Vec3(r * std::cos(a), z, r * std::sin(a));
   }
-  // Joint velocities zero: v_i = v_p + w_p x s_i - w_i x r_i, parents first.
-  for (int i = 1; i < out.model.count; ++i) {
-    const int p = out.model.parent[i];
-    const Vec3 r = s.orientation[i] * out.model.joint_in_child[i];
-    Vec3 joint_velocity = Vec3::Zero();
-    if (p != 0) joint_velocity = s.velocity[p] + s.angular[p].cross(s.orientation[p] * out.model.joint_in_parent[i]);
-    s.velocity[i] = joint_velocity - s.angular[i].cross(r);
-  }
+  set_velocities_keeping_joints(out.model, s);
   return out;
 }
 
@@ -131,12 +124,7 @@ TEST(SparseCorrections, MoveSlenderFastBarsAsFullCorrectionsDo) {
     direction[(axis + 1) % 3] = std::sin(0.1);
     s.angular[b] = s.orientation[b] * (30.0 * direction);
   }
-  for (int i = 1; i < model.count; ++i) {
-    const int p = model.parent[i];
-    Vec3 joint_velocity = Vec3::Zero();
-    if (p != 0) joint_velocity = s.velocity[p] + s.angular[p].cross(s.orientation[p] * model.joint_in_parent[i]);
-    s.velocity[i] = joint_velocity - s.angular[i].cross(s.orientation[i] * model.joint_in_child[i]);
-  }
+  set_velocities_keeping_joints(model, s);
   const int steps = 150;
   const double h = model.timestep;
   const double tolerance = Simulation(model).joint_tolerance(h);

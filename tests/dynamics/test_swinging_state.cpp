@@ -54,6 +54,31 @@ TEST(SwingingState, KeepsEveryJointTogetherAndTurnsEachComponentWithinTheRates) 
   }
 }
 
+// place_on_joints and set_velocities_keeping_joints, which build it: from any orientations and angular
+// velocities (here every component turned 0.3 rad about its own axis, spinning at 2 rad/s), the joints
+// hold in position and in velocity.
+TEST(SwingingState, PlacingOnTheJointsKeepsThemTogetherInPositionAndVelocity) {
+  const Model model = generated(127);
+  State state = rest_state(model);
+  for (int i = 1; i < model.count; ++i) {
+    const Vec3 axis = Vec3(std::cos(i), std::sin(i), 0.5).normalized();  // spread, no two alike
+    state.orientation[i] = (Quat(Eigen::AngleAxisd(0.3, axis)) * state.orientation[i]).normalized();
+    state.angular[i] = 2.0 * axis;
+  }
+  const double apart_before = max_joint_separation(model, state);
+  EXPECT_GT(apart_before, 1e-3);  // m: the turns opened the joints
+  place_on_joints(model, state);
+  // Joint arms of a metre or less and a few roundings each along a path of at most 7 joints: 1e-14 m.
+  EXPECT_LT(max_joint_separation(model, state), 1e-14);
+  set_velocities_keeping_joints(model, state);
+  for (int i = 1; i < model.count; ++i) {
+    // Speeds of a few m/s at most (2 rad/s over paths of a few metres): 1e-13 m/s is a few roundings.
+    const Vec3 joint = joint_on_child(model, state, i);
+    const Vec3 gap = point_velocity(state, i, joint) - point_velocity(state, model.parent[i], joint);
+    EXPECT_LT(gap.norm(), 1e-13) << "component " << i;
+  }
+}
+
 TEST(SwingingState, SpreadsTheTurnsOverEveryDirection) {
   const Model model = generated(1023);
   const State state = swinging_state(model, 0.5, 7);
