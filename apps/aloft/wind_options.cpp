@@ -61,22 +61,6 @@ CLI::Validator wind_speed() {
 
 namespace {
 
-// Centre and radius (m) of a sphere around the whole mobile at `state`.
-std::pair<Vec3, double> mobile_sphere(const Model& model, const State& state) {
-  Bounds world;
-  for (int c = 0; c < model.count; ++c) {
-    const Mat3 rotation = state.orientation[c].toRotationMatrix();
-    for (const BodyShape& shape : model.shapes[c]) {
-      const Bounds b = shape_bounds(shape.shape);
-      for (int corner = 0; corner < 8; ++corner)
-        world.add(state.position[c] + rotation * Vec3((corner & 1) ? b.max.x() : b.min.x(),
-                                                      (corner & 2) ? b.max.y() : b.min.y(),
-                                                      (corner & 4) ? b.max.z() : b.min.z()));
-    }
-  }
-  return {0.5 * (world.min + world.max), 0.5 * (world.max - world.min).norm()};
-}
-
 std::string point_text(const Vec3& p) { return format("(%.3g, %.3g, %.3g)", p.x(), p.y(), p.z()); }
 
 // The settings the flags give every wind (file sources may override alpha, beta and seed).
@@ -210,19 +194,15 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
   WindDriver d;
   // Where the wind comes from: S0 at `from` blowing towards `to`, the cone just covering the mobile
   // unless r0 is given.
-  const auto [center, radius] = mobile_sphere(model, state);
-  const Vec3 to = o.to.empty() ? center : *read_point(o.to);
-  const Vec3 from = o.from.empty() ? Vec3(center + Vec3(0, 0, 1.5)) : *read_point(o.from);
+  const MobileSphere cover = mobile_sphere(model, state);
+  const Vec3 to = o.to.empty() ? cover.center : *read_point(o.to);
+  const Vec3 from = o.from.empty() ? Vec3(cover.center + Vec3(0, 0, 1.5)) : *read_point(o.from);
   if ((to - from).norm() < 1e-9) throw Failure("--wind-from and --wind-to must be two different points");
-  double r0 = o.r0;
-  if (r0 <= 0) {
-    const double reach = (center - from).norm() + o.l0;
-    const double sine = std::min(0.95, radius / reach);
-    r0 = o.l0 * sine / std::sqrt(1 - sine * sine);
-  }
   const WindSettings settings = settings_from_flags(o);
   try {
-    d.wind = std::make_unique<Wind>(model, WindSource::aimed(from, to, r0, o.l0), settings);
+    const WindSource source =
+        o.r0 > 0 ? WindSource::aimed(from, to, o.r0, o.l0) : source_covering(from, to, o.l0, cover);
+    d.wind = std::make_unique<Wind>(model, source, settings);
   } catch (const std::invalid_argument& e) {
     throw Failure(e.what());
   }
@@ -249,8 +229,8 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
   }
   d.description = speed + format("; S0 at %s r0 = %.3g m, l0 = %.3g m, towards %s; alpha = %.3g kg m, beta = %g; "
                                  "occlusion %d px every %d steps",
-                                 point_text(from).c_str(), r0, o.l0, point_text(to).c_str(), d.wind->alpha(), o.beta,
-                                 o.resolution, d.refresh_every);
+                                 point_text(from).c_str(), d.wind->source().r0, o.l0, point_text(to).c_str(),
+                                 d.wind->alpha(), o.beta, o.resolution, d.refresh_every);
   return d;
 }
 

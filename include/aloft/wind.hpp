@@ -60,6 +60,19 @@ struct WindSource {
   void validate() const;
 };
 
+// A sphere around the whole mobile at `state`: centred on the world box of every shape's corners, its
+// radius the box's half diagonal (m). What the sources below are sized to cover.
+struct MobileSphere {
+  Vec3 center;    // world, m
+  double radius;  // m
+};
+MobileSphere mobile_sphere(const Model& model, const State& state);
+
+// A source whose disc S0 is centred at `from` and blows towards `to` (as WindSource::aimed), its r0
+// wide enough that the cone covers `cover` as seen `|cover.center - from| + l0` from the vertex (the
+// half angle capped at 72 degrees). Throws std::invalid_argument as aimed does.
+WindSource source_covering(const Vec3& from, const Vec3& to, double l0, const MobileSphere& cover);
+
 // A source placed in front of the whole mobile at rest: S0 centred `distance` (m) from the mobile's
 // bounding-box centre along -along (the wind blows along `along`), radius chosen so that the cone covers
 // the whole mobile at the box centre's distance, l0 = `l0`. The viewer's default is along the camera's

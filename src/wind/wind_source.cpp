@@ -60,13 +60,8 @@ void WindSettings::validate() const {
                                 std::to_string(round_segments));
 }
 
-WindSource source_facing_mobile(const Model& model, const State& state, const Vec3& along, double distance,
-                                double l0) {
-  require_positive(distance, "the wind source's distance", "m");
-  require_positive(l0, "the wind's l0", "m");
-  if (!(along.norm() > 0)) throw std::invalid_argument("the wind's direction must not be zero");
-  // World bounds of every shape at this state (corners of each body-frame box, transformed).
-  Bounds world;
+MobileSphere mobile_sphere(const Model& model, const State& state) {
+  Bounds world;  // of the corners of every shape's body-frame box, carried to the world
   for (int c = 0; c < model.count; ++c) {
     const Mat3 rotation = state.orientation[c].toRotationMatrix();
     for (const BodyShape& shape : model.shapes[c]) {
@@ -78,16 +73,22 @@ WindSource source_facing_mobile(const Model& model, const State& state, const Ve
       }
     }
   }
-  const Vec3 center = 0.5 * (world.min + world.max);
-  const double radius = 0.5 * (world.max - world.min).norm();
-  WindSource s;
-  s.direction = along.normalized();
-  s.l0 = l0;
-  s.vertex = center - (distance + l0) * s.direction;
-  // The cone's half angle covers a sphere around the bounds at the centre's distance (capped at 72 deg).
-  const double sine = std::min(0.95, radius / (distance + l0));
-  s.r0 = l0 * sine / std::sqrt(1 - sine * sine);
-  return s;
+  return {0.5 * (world.min + world.max), 0.5 * (world.max - world.min).norm()};
+}
+
+WindSource source_covering(const Vec3& from, const Vec3& to, double l0, const MobileSphere& cover) {
+  require_positive(l0, "the wind's l0", "m");
+  const double reach = (cover.center - from).norm() + l0;  // m, from the vertex when `to` is the centre
+  const double sine = std::min(0.95, cover.radius / reach);  // of the half angle; 0.95: 72 degrees
+  return WindSource::aimed(from, to, l0 * sine / std::sqrt(1 - sine * sine), l0);
+}
+
+WindSource source_facing_mobile(const Model& model, const State& state, const Vec3& along, double distance,
+                                double l0) {
+  require_positive(distance, "the wind source's distance", "m");
+  if (!(along.norm() > 0)) throw std::invalid_argument("the wind's direction must not be zero");
+  const MobileSphere cover = mobile_sphere(model, state);
+  return source_covering(cover.center - distance * along.normalized(), cover.center, l0, cover);
 }
 
 }  // namespace aloft

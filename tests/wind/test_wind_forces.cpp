@@ -3,9 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include "aloft/geometry.hpp"
+#include "support/presets.hpp"
 #include "wind/wind_scenes.hpp"
 
 namespace aloft::test {
@@ -181,6 +184,38 @@ TEST(WindSource, AimedPutsS0AtFromAndValidates) {
   WindSettings bad;
   bad.resolution = 2;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
+// The sources sized to the mobile: the Steel Fish's every shape corner lies in mobile_sphere, and the
+// cone of source_facing_mobile (and of source_covering, off to one side) holds that whole sphere.
+TEST(WindSource, SourcesFacingTheMobileCoverItsWholeSphere) {
+  const Model model = load_mobile(preset_path("steel-fish"));
+  const State state = rest_state(model);
+  const MobileSphere cover = mobile_sphere(model, state);
+  for (int c = 0; c < model.count; ++c)
+    for (const BodyShape& shape : model.shapes[c]) {
+      const Bounds b = shape_bounds(shape.shape);
+      for (const Vec3& corner : {b.min, b.max})  // two opposite corners of each box
+        EXPECT_LE((state.position[c] + state.orientation[c] * corner - cover.center).norm(),
+                  cover.radius * (1 + 1e-12));  // relative round-off of a metre-sized sum
+    }
+  const auto holds_sphere = [&](const WindSource& s) {
+    // The sphere's angular radius seen from the vertex, plus its centre's angle off the axis, within the
+    // cone's half angle (1e-12 rad: the round-off of the trigonometry).
+    const Vec3 to_center = cover.center - s.vertex;
+    const double off_axis = std::acos(std::clamp(to_center.normalized().dot(s.direction), -1.0, 1.0));
+    return off_axis + std::asin(cover.radius / to_center.norm()) <= s.half_angle() + 1e-12;
+  };
+  const WindSource facing = source_facing_mobile(model, state, Vec3(0, 0, -1), 1.5, 1.0);
+  EXPECT_TRUE(holds_sphere(facing));
+  EXPECT_NEAR((facing.disc_center() - (cover.center + Vec3(0, 0, 1.5))).norm(), 0, 1e-12);
+  // Aimed at the centre from elsewhere: S0 where asked, the cone still holding the sphere, and no wider
+  // than it needs (the sphere touches the cone: 1e-9 of its half angle).
+  const Vec3 from = cover.center + Vec3(1, 0.5, 2);
+  const WindSource aimed = source_covering(from, cover.center, 0.8, cover);
+  EXPECT_NEAR((aimed.disc_center() - from).norm(), 0, 1e-12);
+  EXPECT_TRUE(holds_sphere(aimed));
+  EXPECT_NEAR(std::asin(cover.radius / (cover.center - aimed.vertex).norm()), aimed.half_angle(), 1e-9);
 }
 
 }  // namespace
