@@ -15,8 +15,8 @@
 //       (aloft/contact_law_record.hpp), to be solved again by aloft_law_replay: every N-th (default 1) of
 //       those with M contacts or more (default 1)
 //     --wind V0: the steps after the start (the first one included) blown by the paper's wind, v0 m/s
-//       steady (TimedWind below: the mobile as it moves in its main use); the wind's own work is timed
-//       apart and printed, not counted in the step's figures
+//       steady, placed as `aloft bench --wind` places it (aloft/blown_steps.hpp: the mobile as it moves in
+//       its main use); the wind's own work is timed apart and printed, not counted in the step's figures
 //     MOBILE: a mobile file (.json) or a component count for generate_mobile (seed 1)
 //     SEED: of the swinging state's random spins (default 7, the benchmarks'); with collisions on, the
 //       knocks make the motion chaotic, so comparing two builds over a few seeds says more than over one
@@ -42,49 +42,24 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <memory>
 #include <string>
 #include <utility>
 
+#include "aloft/blown_steps.hpp"
 #include "aloft/contact_law_record.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
 #include "aloft/state.hpp"
 #include "aloft/thread_clock.hpp"
-#include "aloft/wind.hpp"
 #include "bench_models.hpp"
 
 namespace {
 
-// The paper's wind on the timed steps (--wind V0): a steady v0 from a source 1.5 m in front (+z) of the
-// mobile at rest, blowing along -z, its cone just covering the mobile (source_facing_mobile, as the
-// command line's default), the default settings (turbulence beta 0.3, seed 1), and the occlusion
-// refreshed every 17 steps (60 Hz at 1 ms, as `aloft simulate`). Its own work (refresh and apply) is
-// timed apart and left out of the step's figure, so both columns of a collisions on / off comparison
-// time the step alone.
-struct TimedWind {
-  std::unique_ptr<aloft::Wind> wind;
-  double v0 = 0;              // m/s at S0
-  long steps_taken = 0;       // steps blown so far (the refresh schedule)
-  aloft::ApartTimer timer;    // the wind's refresh and apply, timed apart from the steps
-  static constexpr int kRefreshEvery = 17;
-};
-
-// One step of the run: the wind's loads first (timed apart), when there is a wind.
-bool take_step(aloft::Simulation& sim, TimedWind* wind) {
-  if (wind) {
-    wind->timer.apart([&] {
-      if (wind->steps_taken++ % TimedWind::kRefreshEvery == 0) wind->wind->refresh_occlusion(sim.state());
-      sim.loads().clear();
-      wind->wind->apply(sim.state(), wind->v0, sim.timestep(), sim.loads());
-    });
-  }
-  return sim.step();
-}
-
-__attribute__((noinline)) bool timed_steps(aloft::Simulation& sim, long steps, TimedWind* wind) {
+// The steps callgrind's --toggle-collect times, each blown first when there is a wind (its work timed
+// apart by BlownSteps).
+__attribute__((noinline)) bool timed_steps(aloft::BlownSteps& steps_of, long steps) {
   for (long k = 0; k < steps; ++k)
-    if (!take_step(sim, wind)) return false;
+    if (!steps_of.step()) return false;
   return true;
 }
 
@@ -228,14 +203,8 @@ int main(int argc, char** argv) {
         if (!sim.step()) throw std::runtime_error(sim.failure()->message);
       sim.loads().clear();
     }
-    std::unique_ptr<TimedWind> wind;
-    if (wind_v0 > 0) {
-      wind = std::make_unique<TimedWind>();
-      wind->wind = std::make_unique<Wind>(
-          model, source_facing_mobile(model, rest_state(model), Vec3(0, 0, -1), 1.5, 1.0), WindSettings{});
-      wind->v0 = wind_v0;
-    }
-    if (!breeze && !take_step(sim, wind.get()))  // the first factorization (the wind's first step, if any)
+    BlownSteps blown(model, sim, wind_v0);  // plain steps when wind_v0 is 0
+    if (!breeze && !blown.step())  // the first factorization (the wind's first step, if any)
       throw std::runtime_error(sim.failure()->message);
     sim.set_joint_tolerance(joint_tolerance);
     // The timed steps' contact-law solves, every record_every-th of those with at least record_min
@@ -262,9 +231,9 @@ int main(int argc, char** argv) {
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
       const double start = thread_seconds();
-      const double wind_start = wind ? wind->timer.taken_from_span() : 0.0;
-      if (!timed_steps(sim, block, wind.get())) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = thread_seconds() - start - (wind ? wind->timer.taken_from_span() - wind_start : 0.0);
+      const double wind_start = blown.wind_seconds();
+      if (!timed_steps(blown, block)) throw std::runtime_error(sim.failure()->message);
+      const double block_seconds = thread_seconds() - start - (blown.wind_seconds() - wind_start);
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping
@@ -297,10 +266,10 @@ int main(int argc, char** argv) {
                 what.c_str(), 1e6 * seconds / steps, 1e6 * seconds / steps / (model.count - 1), subdivided / steps,
                 (static_cast<double>(sim.joint_iterations() - iterations) + steps + subdivided) / steps, checksum);
     print_rates("  ", before, counts_of(sim), steps);
-    if (wind)
+    if (blown.v0() > 0)
       std::printf("  wind: v0 = %g m/s; its occlusion refreshes and loads took %.3f us per step, left out of the "
                   "figures above\n",
-                  wind->v0, 1e6 * wind->timer.work_seconds() / wind->steps_taken);
+                  blown.v0(), 1e6 * blown.wind_work_seconds() / blown.steps_blown());
     if (!record_path.empty()) {
       record_file.close();
       if (!record_file) throw std::runtime_error("could not finish writing " + record_path);

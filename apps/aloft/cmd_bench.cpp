@@ -18,10 +18,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <optional>
 #include <thread>
 
+#include "aloft/blown_steps.hpp"
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
@@ -134,37 +134,11 @@ std::optional<State> breeze_start(const Model& model, const std::string& name, s
 // The timing both ways: `repetitions` runs of `fixed_steps` steps each (or, if it is 0, enough for 0.5 s),
 // one after another from the start; the median rate is reported. With a wind (v0 > 0, m/s) every step
 // is blown by it, placed as `aloft simulate --wind V0` places it, and its own work (occlusion and loads)
-// is left out of the figures.
+// is left out of the figures (BlownSteps, aloft/blown_steps.hpp).
 struct Timing {
   long long fixed_steps = 0;
   int repetitions = 5;
   double wind = 0;
-};
-
-// The steps of a measurement: each blown by the wind first, if there is one, the wind's work timed apart
-// (wind_seconds: what a span of steps gives up for it).
-class BlownSteps {
- public:
-  BlownSteps(const Model& model, Simulation& sim, double v0) : sim_(sim) {
-    if (!(v0 > 0)) return;
-    WindOptions options;
-    options.constant = v0;
-    options.no_file_wind = true;
-    wind_ = std::make_unique<WindSet>(model, MobileSpec{}, sim.state(), options, sim.timestep());
-    timer_ = std::make_unique<ApartTimer>();
-  }
-  bool step() {
-    if (wind_) timer_->apart([&] { wind_->apply(steps_++, sim_.state(), sim_.timestep(), sim_.loads()); });
-    return sim_.step();
-  }
-  // The CPU time (s) a span of steps gives up for the wind so far (none without a wind).
-  double wind_seconds() const { return timer_ ? timer_->taken_from_span() : 0.0; }
-
- private:
-  Simulation& sim_;
-  std::unique_ptr<WindSet> wind_;
-  std::unique_ptr<ApartTimer> timer_;  // made with the wind (it calibrates the clock's cost, 8 ms)
-  long long steps_ = 0;
 };
 
 Measurement measure(const Model& model, const State& start, const Timing& timing, bool collisions) {
