@@ -42,9 +42,11 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <utility>
 
+#include "aloft/bench_start.hpp"
 #include "aloft/blown_steps.hpp"
 #include "aloft/contact_law_record.hpp"
 #include "aloft/model.hpp"
@@ -163,26 +165,17 @@ int main(int argc, char** argv) {
   const std::string what = argv[1];
   const long steps = std::atol(argv[2]);
   const bool collisions = argc > 3 && std::atoi(argv[3]) != 0;
-  const std::string start = argc > 4 ? argv[4] : "breeze";
-  const std::size_t colon = start.find(':');
-  const std::string start_from = start.substr(0, colon);
-  unsigned long seed = 7;  // swinging_state's default
-  bool seed_ok = true;
-  if (colon != std::string::npos) {
-    const std::string digits = start.substr(colon + 1);
-    char* end = nullptr;
-    seed = std::strtoul(digits.c_str(), &end, 10);
-    seed_ok = !digits.empty() && *end == '\0' && start_from == "swinging";
-  }
-  if ((start_from != "rest" && start_from != "breeze" && start_from != "swinging") || !seed_ok) {
+  const std::string start_name = argc > 4 ? argv[4] : "breeze";
+  const std::optional<BenchStart> start = parse_bench_start(start_name);
+  if (!start) {
     std::fprintf(stderr,
                  "aloft_step_profile: the start is 'rest', 'breeze', 'swinging' or 'swinging:SEED' (SEED a whole "
                  "number), not '%s'\n",
-                 start.c_str());
+                 start_name.c_str());
     return 2;
   }
-  const bool swinging = start_from == "swinging";
-  const bool breeze = start_from == "breeze";
+  const bool swinging = start->from == BenchStart::From::kSwinging;
+  const bool breeze = start->from == BenchStart::From::kBreeze;
   const double joint_tolerance = argc > 5 ? std::atof(argv[5]) : 0.0;
   if (!(joint_tolerance >= 0)) {
     std::fprintf(stderr, "aloft_step_profile: the joint tolerance is a length >= 0 (m), not '%s'\n", argv[5]);
@@ -195,11 +188,11 @@ int main(int argc, char** argv) {
     } else {
       model = std::move(*bench::generated_model(std::atoi(what.c_str())));  // seed 1
     }
-    Simulation sim(model, swinging ? swinging_state(model, 0.5, seed) : rest_state(model));
+    Simulation sim(model, swinging ? swinging_state(model, 0.5, start->seed) : rest_state(model));
     sim.set_collisions(collisions);
     if (breeze) {
       set_breeze(model, sim.loads());  // as `aloft bench`
-      for (int k = 0; k < 300; ++k)
+      for (int k = 0; k < kBreezeSteps; ++k)
         if (!sim.step()) throw std::runtime_error(sim.failure()->message);
       sim.loads().clear();
     }
@@ -230,10 +223,10 @@ int main(int argc, char** argv) {
       const long block = every > 0 ? std::min(every, steps - done) : steps;
       const Counts block_start = counts_of(sim);
       const long long block_halvings = sim.subdivisions();
-      const double start = thread_seconds();
+      const double clock_start = thread_seconds();
       const double wind_start = blown.wind_seconds();
       if (!timed_steps(blown, block)) throw std::runtime_error(sim.failure()->message);
-      const double block_seconds = thread_seconds() - start - (blown.wind_seconds() - wind_start);
+      const double block_seconds = thread_seconds() - clock_start - (blown.wind_seconds() - wind_start);
       seconds += block_seconds;
       if (every > 0) {
         // Where the motion stands at the block's end: the mobile's energy (the swing loses it to damping

@@ -12,7 +12,6 @@
 // in the paper's wind, the wind's own work left out: the mobile as it moves in its main use.
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -21,6 +20,7 @@
 #include <optional>
 #include <thread>
 
+#include "aloft/bench_start.hpp"
 #include "aloft/blown_steps.hpp"
 #include "aloft/generate.hpp"
 #include "aloft/model.hpp"
@@ -68,44 +68,17 @@ std::string failure_of(const Simulation& sim) {
   return sim.failure() ? sim.failure()->message : std::string("the simulation failed");
 }
 
-// Steps of the breeze that sets a mobile swinging before it is timed: 0.3 s at the default 1 ms step.
-// A count, not a time, so that every machine times the same motion.
-constexpr int kBreezeSteps = 300;
-
-// Where both timed runs of a mobile start (--start): after the breeze (the default), from the
-// benchmarks' swinging state of `seed` (swinging_state, max rate 0.5 rad/s, as BM_StepSpan), or from the
-// designed pose at rest (for --wind, which then sets the mobile moving).
-struct BenchStart {
-  enum class From { kBreeze, kSwinging, kRest };
-  From from = From::kBreeze;
-  std::uint64_t seed = 7;  // swinging_state's default, BM_StepSpan's start
-
-  std::string describe() const {
-    switch (from) {
-      case From::kSwinging:
-        return format("the swinging state of seed %llu (as BM_StepSpan)", static_cast<unsigned long long>(seed));
-      case From::kRest:
-        return "the designed pose at rest";
-      case From::kBreeze:
-        break;
-    }
-    return format("%d steps of a breeze with collisions on", kBreezeSteps);
+// Where both timed runs of a mobile start (--start, aloft/bench_start.hpp), for the report's header.
+std::string describe(const BenchStart& start) {
+  switch (start.from) {
+    case BenchStart::From::kSwinging:
+      return format("the swinging state of seed %llu (as BM_StepSpan)", static_cast<unsigned long long>(start.seed));
+    case BenchStart::From::kRest:
+      return "the designed pose at rest";
+    case BenchStart::From::kBreeze:
+      break;
   }
-};
-
-// "breeze", "rest", "swinging" or "swinging:SEED" (SEED a whole number); empty if the text is none of
-// these.
-std::optional<BenchStart> parse_start(const std::string& text) {
-  if (text == "breeze") return BenchStart{};
-  if (text == "rest") return BenchStart{BenchStart::From::kRest};
-  if (text == "swinging") return BenchStart{BenchStart::From::kSwinging};
-  const std::string prefix = "swinging:";
-  if (text.rfind(prefix, 0) != 0 || text.size() == prefix.size()) return std::nullopt;
-  BenchStart start{BenchStart::From::kSwinging};
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data() + prefix.size(), end, start.seed);
-  if (ec != std::errc() || ptr != end) return std::nullopt;
-  return start;
+  return format("%d steps of a breeze with collisions on", kBreezeSteps);
 }
 
 // The state both timed runs of a mobile start from: the designed pose at rest, pushed for kBreezeSteps
@@ -260,7 +233,7 @@ Runner add_bench(CLI::App& app) {
       ->type_name("FROM")
       ->check(CLI::Validator(
           [](std::string& input) -> std::string {
-            return parse_start(input) ? std::string()
+            return parse_bench_start(input) ? std::string()
                                       : "must be 'breeze', 'rest', 'swinging' or 'swinging:SEED' (SEED a whole "
                                         "number), got \"" +
                                             input + "\"";
@@ -307,14 +280,14 @@ Runner add_bench(CLI::App& app) {
       "  aloft bench --sizes 127,1023 --start rest --wind 3 --repetitions 1 --steps 3000   # in a breath\n");
   return [o] {
     namespace fs = std::filesystem;
-    const BenchStart start = *parse_start(o->start);  // checked by the option's validator
+    const BenchStart start = *parse_bench_start(o->start);  // checked by the option's validator
     const Timing timing{o->steps, o->repetitions, o->wind};
     const std::string dir = o->presets.empty() ? (fs::path(source_dir()) / "mobiles").string() : o->presets;
     std::printf("aloft bench: %s, %u cores; build %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
                 ALOFT_BUILD_TYPE);
     std::printf("thread CPU time, median of %d repetition%s of %s; both columns from the same start,\n%s%s\n\n",
                 timing.repetitions, timing.repetitions == 1 ? "" : "s",
-                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", start.describe().c_str(),
+                o->steps > 0 ? format("%lld steps", o->steps).c_str() : "at least 0.5 s", describe(start).c_str(),
                 timing.wind > 0 ? format(", in a steady wind of v0 = %g m/s (its own work left out)", timing.wind).c_str()
                                 : "");
     std::printf("%-27s %-46s | %s\n", "", "collisions off (issue 2)", "collisions on (issue 3)");
