@@ -28,6 +28,7 @@
 #include "aloft/state.hpp"
 #include "aloft/thread_clock.hpp"
 #include "common.hpp"
+#include "progress.hpp"
 #include "wind_options.hpp"
 
 #ifndef ALOFT_BUILD_TYPE
@@ -90,17 +91,16 @@ std::optional<State> breeze_start(const Model& model, const std::string& name, s
   Simulation sim(model);
   sim.set_collisions(true);
   set_breeze(model, sim.loads());
-  const bool show_progress = is_terminal(stderr);
-  const double started = thread_seconds();
-  for (int s = 0; s < kBreezeSteps; ++s) {
+  ProgressReport progress(is_terminal(stderr), kBreezeSteps, name + ": breeze", 1.0);  // the table stays clean
+  for (int s = 1; s <= kBreezeSteps; ++s) {
     if (!sim.step()) {
+      progress.finish();
       failure = "in the breeze: " + failure_of(sim);
       return std::nullopt;
     }
-    if (show_progress && s % 10 == 9 && seconds_since(started) > 1)
-      std::fprintf(stderr, "\r%s: breeze, step %d of %d ", name.c_str(), s + 1, kBreezeSteps);
+    if (progress.due(s)) progress.show(s, format("step %d of %d", s, kBreezeSteps));
   }
-  if (show_progress && seconds_since(started) > 1) std::fprintf(stderr, "\r\033[K");
+  progress.finish();
   return sim.state();
 }
 
