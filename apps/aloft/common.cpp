@@ -105,6 +105,17 @@ CLI::Validator positive_number() {
       "");
 }
 
+CLI::Validator non_negative_number() {
+  return CLI::Validator(
+      [](std::string& input) -> std::string {
+        const std::optional<double> v = read_number(input);
+        if (!v) return "must be a number, got \"" + input + "\"";
+        if (!(*v >= 0) || !std::isfinite(*v)) return "must be a number >= 0, got " + input;
+        return {};
+      },
+      "");
+}
+
 CLI::Validator number_in(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) -> std::string {

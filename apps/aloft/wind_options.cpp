@@ -37,16 +37,6 @@ CLI::Validator point_validator() {
       "");
 }
 
-CLI::Validator non_negative() {
-  return CLI::Validator(
-      [](std::string& input) -> std::string {
-        const std::optional<double> v = read_number(input);
-        if (v && std::isfinite(*v) && *v >= 0) return {};
-        return "must be a number >= 0, got \"" + input + "\"";
-      },
-      "");
-}
-
 }  // namespace
 
 CLI::Validator wind_speed() {
@@ -142,7 +132,7 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
   sub->add_option("--wind-gust-time", o.gust_time, "Correlation time of the turbulence (s, >= 0)")
       ->type_name("S")
       ->capture_default_str()
-      ->check(non_negative())
+      ->check(non_negative_number())
       ->group(group);
   sub->add_option("--wind-seed", o.seed, "Seed of the turbulence (same seed, same run)")
       ->type_name("N")
@@ -167,7 +157,7 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
   sub->add_option("--wind-gain", o.gain, "With --wind-audio: m/s of v0 per unit of RMS above the noise floor")
       ->type_name("G")
       ->capture_default_str()
-      ->check(non_negative())
+      ->check(non_negative_number())
       ->group(group);
   sub->add_option("--wind-noise-floor", o.noise_floor,
                   "With --wind-audio: the noise floor (RMS, 0 to 1) instead of calibrating it")

@@ -293,6 +293,8 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
       {"render small.json -t 1 --fps abc --out x.png", "--fps: must be a number from 1 to 240, got \"abc\""},
       {"render small.json -t 1 --pitch 90 --out x.png", "--pitch: must be a number from -85 to 85, got \"90\""},
       {"render small.json -t 1 --distance -1 --out x.png", "--distance: must be a positive number, got -1"},
+      {"simulate small.json -t 1 --wind 1 --wind-gust-time -0.5", "--wind-gust-time: must be a number >= 0, got -0.5"},
+      {"simulate small.json -t 1 --wind 1 --wind-gust-time s", "--wind-gust-time: must be a number, got \"s\""},
   };
   for (const auto& [args, message] : cases) {
     const Result r = aloft(args);
