@@ -94,27 +94,25 @@ std::optional<double> read_number(const std::string& input) {
   return std::nullopt;
 }
 
-CLI::Validator positive_number() {
+namespace {
+
+// A finite number above `lo`, or at it too when `lo_allowed`; otherwise "must be <rule>, got X".
+CLI::Validator finite_number_above(double lo, bool lo_allowed, std::string rule) {
   return CLI::Validator(
-      [](std::string& input) -> std::string {
+      [lo, lo_allowed, rule](std::string& input) -> std::string {
         const std::optional<double> v = read_number(input);
         if (!v) return "must be a number, got \"" + input + "\"";
-        if (!(*v > 0) || !std::isfinite(*v)) return "must be a positive number, got " + input;
+        if (!std::isfinite(*v) || !(*v > lo || (lo_allowed && *v == lo))) return "must be " + rule + ", got " + input;
         return {};
       },
       "");
 }
 
-CLI::Validator non_negative_number() {
-  return CLI::Validator(
-      [](std::string& input) -> std::string {
-        const std::optional<double> v = read_number(input);
-        if (!v) return "must be a number, got \"" + input + "\"";
-        if (!(*v >= 0) || !std::isfinite(*v)) return "must be a number >= 0, got " + input;
-        return {};
-      },
-      "");
-}
+}  // namespace
+
+CLI::Validator positive_number() { return finite_number_above(0, false, "a positive number"); }
+
+CLI::Validator non_negative_number() { return finite_number_above(0, true, "a number >= 0"); }
 
 CLI::Validator number_in(double lo, double hi) {
   return CLI::Validator(
