@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "aloft/model.hpp"
+#include "support/test_dir.hpp"
 #include "support/leaning_balls.hpp"
 
 namespace aloft {
@@ -48,11 +49,7 @@ std::string quote(const std::string& s) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("aloft-cli-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::make_test_dir("cli");
   }
   void TearDown() override { fs::remove_all(dir_); }
 

@@ -19,6 +19,7 @@
 #include "aloft/spec.hpp"
 #include "model/format_keys.hpp"
 #include "model/json_locator.hpp"
+#include "support/test_dir.hpp"
 
 namespace aloft {
 namespace {
@@ -35,12 +36,7 @@ int line_of(const std::string& text, const std::string& needle) {
 // A fresh directory under the system's temporary directory, removed at the end of the test.
 class TempDir {
  public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("aloft_parse_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
-    fs::create_directories(path_);
-  }
+  TempDir() : path_(test::make_test_dir("parse")) {}
   ~TempDir() {
     std::error_code ec;
     fs::remove_all(path_, ec);

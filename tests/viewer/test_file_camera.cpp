@@ -3,9 +3,7 @@
 // camera in the file is an error naming the file, line and path.
 
 #include <gtest/gtest.h>
-#include <stb_image.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -18,6 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/png_image.hpp"
+#include "support/test_dir.hpp"
 #include "support/run_aloft.hpp"
 
 namespace {
@@ -27,20 +27,8 @@ namespace fs = std::filesystem;
 const auto quote = aloft::test::shell_quote;
 const auto read = aloft::test::read_file;
 
-struct Image {
-  int width = 0, height = 0;
-  std::vector<unsigned char> rgb;
-};
-
-Image load_png(const fs::path& p) {
-  Image image;
-  int channels = 0;
-  unsigned char* data = stbi_load(p.c_str(), &image.width, &image.height, &channels, 3);
-  if (!data) return image;
-  image.rgb.assign(data, data + static_cast<std::size_t>(image.width) * image.height * 3);
-  stbi_image_free(data);
-  return image;
-}
+using aloft::test::Image;
+using aloft::test::load_png;
 
 // Pixels whose colour differs by more than 8 levels in some channel (llvmpipe is deterministic, so equal
 // scenes give equal pictures; 8 levels only keeps the count from hinging on a rounding of the last bit).
@@ -59,11 +47,7 @@ int differing_pixels(const Image& a, const Image& b) {
 class FileCamera : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("aloft-file-camera-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = aloft::test::make_test_dir("file-camera");
     // The Fan Room with its camera, and the same without it.
     fan_room_ = fs::path(ALOFT_SOURCE_DIR) / "mobiles/fan-room.json";
     nlohmann::json doc = nlohmann::json::parse(read(fan_room_));

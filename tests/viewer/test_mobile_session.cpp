@@ -2,7 +2,6 @@
 // drag-and-drop loads, recompiling with another total mass, the mouse spring and physics pacing.
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <sstream>
 
 #include "mobile_session.hpp"
+#include "support/test_dir.hpp"
 #include "support/leaning_balls.hpp"
 
 namespace aloft::view {
@@ -35,11 +35,7 @@ void write_later(const fs::path& p, const std::string& text, int seconds) {
 class Session : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("aloft-session-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::make_test_dir("session");
     fish_text_ = read(fs::path(ALOFT_SOURCE_DIR) / "mobiles/steel-fish.json");
     fish_ = dir_ / "fish.json";
     std::ofstream(fish_, std::ios::binary) << fish_text_;

@@ -3,9 +3,7 @@
 // a broken file is dropped, and write videos of the right length and size.
 
 #include <gtest/gtest.h>
-#include <stb_image.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "support/png_image.hpp"
+#include "support/test_dir.hpp"
 #include "support/leaning_balls.hpp"
 #include "support/run_aloft.hpp"
 
@@ -31,22 +31,8 @@ struct Result {
 const auto quote = aloft::test::shell_quote;
 const auto read = aloft::test::read_file;
 
-// An RGB image read from a PNG.
-struct Image {
-  int width = 0, height = 0;
-  std::vector<unsigned char> rgb;
-  const unsigned char* at(int x, int y) const { return &rgb[(static_cast<std::size_t>(y) * width + x) * 3]; }
-};
-
-Image load_png(const fs::path& p) {
-  Image image;
-  int channels = 0;
-  unsigned char* data = stbi_load(p.c_str(), &image.width, &image.height, &channels, 3);
-  if (!data) return image;
-  image.rgb.assign(data, data + static_cast<std::size_t>(image.width) * image.height * 3);
-  stbi_image_free(data);
-  return image;
-}
+using aloft::test::Image;
+using aloft::test::load_png;
 
 // Pixels of the preset colours as lit: strong red (the fish and balls, #b3261e / #c1121f), and black
 // steel (#1b1b1b / #141414), counted as pixels darker than `darkest` (the empty gallery's darkest
@@ -86,11 +72,7 @@ int differing_pixels(const Image& a, const Image& b) {
 class Viewer : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("aloft-viewer-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = aloft::test::make_test_dir("viewer");
   }
   void TearDown() override { fs::remove_all(dir_); }
 

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <chrono>
@@ -16,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "support/test_dir.hpp"
 #include "support/run_aloft.hpp"
 
 #include "mobile_session.hpp"
@@ -53,11 +53,7 @@ const std::string kFan = R"([{"name": "fan", "from": [0, 1, 2.5], "to": [0, 1, 0
 class FileWindTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("aloft-file-wind-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "-" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::make_test_dir("file-wind");
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path write(const std::string& name, const std::string& text) const {
