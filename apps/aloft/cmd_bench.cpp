@@ -39,7 +39,8 @@ namespace aloft::cli {
 
 namespace {
 
-double seconds_since(double start) { return thread_seconds() - start; }
+// CPU seconds this thread has used since `start` (a thread_seconds() reading).
+double cpu_seconds_since(double start) { return thread_seconds() - start; }
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
@@ -134,7 +135,7 @@ Measurement measure(const Model& model, const State& start, const Timing& timing
       }
     }
     const double rate = static_cast<double>(kCalibrationSteps) /
-                        std::max(seconds_since(calibration_start) - (blown.wind_seconds() - calibration_wind), 1e-9);
+                        std::max(cpu_seconds_since(calibration_start) - (blown.wind_seconds() - calibration_wind), 1e-9);
     out.steps_per_repetition = std::max(3LL, static_cast<long long>(std::ceil(0.5 * rate)));
   }
 
@@ -152,7 +153,7 @@ Measurement measure(const Model& model, const State& start, const Timing& timing
       }
     }
     const double elapsed =
-        std::max(seconds_since(repetition_start) - (blown.wind_seconds() - repetition_wind), 1e-9);
+        std::max(cpu_seconds_since(repetition_start) - (blown.wind_seconds() - repetition_wind), 1e-9);
     rates.push_back(static_cast<double>(out.steps_per_repetition) / elapsed);
     // Keep a too-short calibration from making the repetitions short: re-measure at >= 0.5 s.
     if (r == 0 && fixed_steps <= 0 && elapsed < 0.4) {

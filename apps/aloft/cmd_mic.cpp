@@ -105,7 +105,7 @@ Runner add_mic(CLI::App& app) {
                  o->noise_floor >= 0 ? "noise floor given" : "calibrating the noise floor: stay quiet");
     std::signal(SIGINT, on_interrupt);
     const bool tty = is_terminal(stdout);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = WallClock::now();
     double last_line = -1;
     double peak = 0;
     bool announced = o->noise_floor >= 0;

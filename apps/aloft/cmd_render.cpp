@@ -2,7 +2,6 @@
 // video, a still PNG or a directory of PNG frames. The same renderer as `aloft view`.
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -117,7 +116,7 @@ Runner add_render(CLI::App& app) {
     const long long frames = sink.wants_every_frame() ? std::max(1LL, std::llround(o->duration * o->fps)) : 1;
     std::vector<std::uint8_t> pixels;
     ProgressReport progress(!o->quiet, frames, "rendering", 0.0);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = WallClock::now();
     const auto draw_frame = [&] {
       if (o->glow_touching) {
         touched.components_touching_since(-INFINITY, model.count, options.glowing);

@@ -3,7 +3,6 @@
 // separation, collisions).
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,7 +21,7 @@ namespace aloft::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = WallClock;
 
 // The trajectory CSV, written frame by frame through a large buffer.
 class Trajectory {

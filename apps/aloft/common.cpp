@@ -80,10 +80,6 @@ std::string source_dir() {
 #endif
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 std::optional<double> read_number(const std::string& input) {
   try {
     std::size_t used = 0;

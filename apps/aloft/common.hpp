@@ -2,7 +2,6 @@
 // Shared pieces of the `aloft` command line: subcommand registration, errors, number formatting, CSV
 // quoting, terminal detection.
 
-#include <chrono>
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -13,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "aloft/model.hpp"
+#include "aloft/wall_clock.hpp"
 
 namespace aloft::cli {
 
@@ -71,9 +71,6 @@ std::string fixed(double value, int decimals);
 
 // A CSV field per RFC 4180: quoted (with doubled quotes) if it holds a comma, quote, CR or LF.
 std::string csv_field(const std::string& text);
-
-// Wall-clock seconds since `start` (the steady clock).
-double seconds_since(std::chrono::steady_clock::time_point start);
 
 // Whether the stream is an interactive terminal.
 bool is_terminal(std::FILE* stream);

@@ -2,8 +2,9 @@
 // A long run's progress on stderr (`aloft simulate`, `aloft render`): on a terminal one line rewritten in
 // place, at most four times a second; otherwise (a log file, a pipe) one line per tenth of the run.
 
-#include <chrono>
 #include <string>
+
+#include "aloft/wall_clock.hpp"
 
 namespace aloft::cli {
 
@@ -29,7 +30,7 @@ class ProgressReport {
   std::string verb_;
   double quiet_seconds_;
   bool terminal_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  WallClock::time_point start_ = WallClock::now();
   double last_shown_ = -1;  // s, on a terminal
   int tenths_shown_ = 0;    // otherwise
   bool drawn_ = false;      // a terminal line is on the screen

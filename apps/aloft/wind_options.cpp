@@ -3,7 +3,6 @@
 #include "wind_options.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -259,7 +258,7 @@ void WindSet::apply(long long step, const State& state, double h, ExternalLoads&
   loads.clear();
   for (WindDriver& d : drivers_) {
     if (step % d.refresh_every == 0) {
-      const auto t0 = std::chrono::steady_clock::now();
+      const auto t0 = WallClock::now();
       d.wind->refresh_occlusion(state);
       occlusion_seconds_ += seconds_since(t0);
       ++refreshes_;

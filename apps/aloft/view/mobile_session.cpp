@@ -1,19 +1,18 @@
 #include "mobile_session.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
 
 #include "aloft/error.hpp"
+#include "aloft/wall_clock.hpp"
 
 namespace aloft::view {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+using Clock = WallClock;
 
 // The mouse spring: stiffness per kilogram of the whole mobile (N/m per kg), so that a pull of 10 cm
 // on any mobile gives an acceleration of about 6 m/s^2 to the whole; damped critically on the grabbed
@@ -271,7 +270,7 @@ void MobileSession::step_once() {
     }
     wind_->apply(sim_->state(), v0(), h, loads);
     since_refresh_ += h;
-    wind_seconds_ += seconds(Clock::now() - t0);
+    wind_seconds_ += seconds_since(t0);
   }
   {
     const auto t0 = Clock::now();
@@ -287,7 +286,7 @@ void MobileSession::step_once() {
       w.wind->apply(sim_->state(), w.source.v0(sim_->state().time), h, loads);
       w.since_refresh += h;
     }
-    wind_seconds_ += seconds(Clock::now() - t0);
+    wind_seconds_ += seconds_since(t0);
   }
   gust_level_ *= std::exp(-h / wind_control.gust_time);
 #endif
@@ -300,7 +299,7 @@ void MobileSession::step_once() {
   }
   const auto t0 = Clock::now();
   const bool stepped = sim_->step();
-  physics_seconds_ += seconds(Clock::now() - t0);
+  physics_seconds_ += seconds_since(t0);
   if (stepped && sim_->collisions()) contacts_.add_step(sim_->contacts(), sim_->pushed_pairs(), sim_->state().time);
 }
 
@@ -317,7 +316,7 @@ double MobileSession::advance(double wall_seconds, double budget_seconds) {
   while (debt_ >= h * (1 - 1e-9) && !failed()) {  // (a whole step owed, to rounding of the sums)
     step_once();
     debt_ -= h;
-    if (seconds(Clock::now() - start) > budget_seconds) {
+    if (seconds_since(start) > budget_seconds) {
       debt_ = std::fmod(debt_, h);  // cannot keep up: drop the rest (slow motion, no spiral)
       break;
     }

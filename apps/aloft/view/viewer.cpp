@@ -28,7 +28,7 @@ namespace aloft::view {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = WallClock;
 constexpr int kWarmupFrames = 10;
 
 // CPU time of the whole process (all threads: llvmpipe rasterises on worker threads), s.
@@ -39,7 +39,6 @@ double process_cpu_seconds() {
          1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 ViewerState& state_of(GLFWwindow* window) { return *static_cast<ViewerState*>(glfwGetWindowUserPointer(window)); }
 
@@ -192,7 +191,7 @@ void ViewerState::drop(const std::string& path) {
 
 void ViewerState::notify(const std::string& text) {
   message = text;
-  message_until = since(start) + 4;
+  message_until = seconds_since(start) + 4;
 }
 
 render::OrbitCamera ViewerState::framed_camera() const {
@@ -406,15 +405,15 @@ int run_viewer(const ViewerOptions& options) {
       glViewport(0, 0, fb_w, fb_h);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
       glFinish();  // the render time below is the whole frame's drawing, not only its submission
-      v.stats.add_render(since(render_start));
+      v.stats.add_render(seconds_since(render_start));
       if (frame == kWarmupFrames) v.totals.cpu_start = process_cpu_seconds();
       if (frame >= kWarmupFrames) {
         // Totals for the exit summary, after the first frames (shader compilation, first uploads).
         v.totals.frames += 1;
         v.totals.physics += v.session->last_physics_seconds();
         v.totals.wind += v.session->last_wind_seconds();
-        v.totals.render += since(render_start);
-        v.totals.wall += since(frame_start);
+        v.totals.render += seconds_since(render_start);
+        v.totals.wall += seconds_since(frame_start);
       }
 
       ++frame;

@@ -185,7 +185,7 @@ std::vector<render::LineSet> ViewerState::overlay_lines() const {
 void ViewerState::draw_panel() {
   error_banner(*session);
   help_window(show_help);
-  const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double now = seconds_since(start);
   if (!message.empty() && now < message_until) {
     const ImGuiViewport* vp = ImGui::GetMainViewport();
     ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y - 12),

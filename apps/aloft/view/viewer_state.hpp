@@ -2,7 +2,6 @@
 // The viewer's state between frames, shared by the window layer (viewer.cpp) and the panel
 // (viewer_panel.cpp).
 
-#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -12,6 +11,7 @@
 #include "aloft/render/frame_target.hpp"
 #include "aloft/render/image_output.hpp"
 #include "aloft/render/renderer.hpp"
+#include "aloft/wall_clock.hpp"
 #include "mobile_session.hpp"
 
 struct GLFWwindow;
@@ -49,7 +49,7 @@ struct ViewerState {
   render::FrameTarget* target = nullptr;
   render::OrbitCamera camera;
   std::function<render::OrbitCamera(render::OrbitCamera)> adjust_camera;
-  std::chrono::steady_clock::time_point start;
+  WallClock::time_point start;
 
   // Display.
   bool show_panel = true;
