@@ -39,7 +39,6 @@ double process_cpu_seconds() {
          1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
-
 ViewerState& state_of(GLFWwindow* window) { return *static_cast<ViewerState*>(glfwGetWindowUserPointer(window)); }
 
 // Cursor position -> normalised device coordinates (y up).
