@@ -27,10 +27,11 @@ Runner add_generate(CLI::App& app) {
       ->type_name("S")
       ->capture_default_str()
       ->check(integer_in(0, 4294967295LL));
-  sub->add_option("-m,--total-mass", o->total_mass, "Total mass of the moving components (kg, > 0)")
+  sub->add_option("-m,--total-mass", o->total_mass,
+                  "Total mass of the moving components (kg, from 1e-6 to 1e6: what a mobile file may say)")
       ->type_name("KG")
       ->capture_default_str()
-      ->check(positive_number());
+      ->check(number_in(kLightestMobile, kHeaviestMobile));
   sub->add_option("-o,--out", o->out, "Output file (default: standard output)")->type_name("FILE");
   sub->footer(
       "The mobile: a fixed hook, a binary tree of wire bars, plates and balls at the leaves, balance\n"

@@ -88,6 +88,22 @@ struct WindProfileSpec {
   double factor(double t) const;
 };
 
+// The sizes a mobile file may give, where the arithmetic of the step and of the collision tests holds.
+// Outside them no mobile is meant, and numbers far outside crash or poison the run: a hook sphere of
+// radius 5.6e128 m crashed libccd's penetration test (found by fuzz_mobile_simulate), and a total mass
+// of 1e300 or 1e-300 kg made the first step non-finite.
+// - Lengths (m): a coordinate's distance from the origin, a size, a radius, a thickness: at most 1 km,
+//   forty times the largest mobiles built (about 25 m; generated ones of 65535 components span 54 m).
+//   An OBJ mesh's vertices, scaled and moved, keep to it too.
+inline constexpr double kLongestLength = 1000.0;
+// - total_mass (kg): from a milligram to a thousand tonnes.
+inline constexpr double kLightestMobile = 1e-6;
+inline constexpr double kHeaviestMobile = 1e6;
+// - Densities (kg/m^3): from 1e-3 (far lighter than any solid; balancing by mass uses only their
+//   ratios) to 1e6 (forty times osmium's).
+inline constexpr double kLeastDensity = 1e-3;
+inline constexpr double kGreatestDensity = 1e6;
+
 // The fastest wind v0 at S0 (m/s) that the mobile file, the command line and a speed series may ask for.
 // The cone's continuity (eq. 2) and drag (eqs. 3-4) treat the air as incompressible, which holds to a few
 // percent below about 0.3 of the speed of sound (343 m/s at 20 C: the density changes by about M^2 / 2,

@@ -354,6 +354,39 @@ class Reader {
     return x;
   }
 
+  // A coordinate (m): a number within kLongestLength of zero.
+  double coordinate(const json& v, const Path& path) const {
+    const double x = number(v, path, "m");
+    if (std::abs(x) > kLongestLength)
+      fail(path, "must be from -" + format_number(kLongestLength) + " to " + format_number(kLongestLength) +
+                     " m (no mobile is larger), got " + describe(v));
+    return x;
+  }
+
+  // A length (m): a positive number of at most kLongestLength. `unit` may say what it measures.
+  double length(const json& v, const Path& path, std::string_view unit = "m") const {
+    const double x = positive(v, path, unit);
+    if (x > kLongestLength)
+      fail(path, "must be at most " + format_number(kLongestLength) + " m (no mobile is larger), got " + describe(v));
+    return x;
+  }
+
+  Vec3 point(const json& v, const Path& path) const {
+    if (!v.is_array() || v.size() != 3) fail(path, "must be an array of 3 numbers [x, y, z] (m), got " + describe(v));
+    return {coordinate(v[0], item(path, 0)), coordinate(v[1], item(path, 1)), coordinate(v[2], item(path, 2))};
+  }
+
+  Vec3 lengths(const json& v, const Path& path) const {
+    if (!v.is_array() || v.size() != 3)
+      fail(path, "must be an array of 3 positive numbers (m), got " + describe(v));
+    return {length(v[0], item(path, 0)), length(v[1], item(path, 1)), length(v[2], item(path, 2))};
+  }
+
+  // A density (kg/m^3) from kLeastDensity to kGreatestDensity.
+  double density(const json& v, const Path& path) const {
+    return in_range(v, path, kLeastDensity, kGreatestDensity, "kg/m^3");
+  }
+
   // A number in [lo, hi] (both finite).
   double in_range(const json& v, const Path& path, double lo, double hi, std::string_view unit) const {
     const double x = v.is_number() ? v.get<double>() : lo - 1;
@@ -404,7 +437,7 @@ void Reader::mobile(const json& root) {
   } else {
     spec_.balance = BalanceSpec{BalanceMode::None, std::nullopt};
   }
-  if (const json* v = find(root, "density")) spec_.density = positive(*v, join(top, "density"), "kg/m^3");
+  if (const json* v = find(root, "density")) spec_.density = density(*v, join(top, "density"));
   if (const json* v = find(root, "damping")) damping(*v, join(top, "damping"));
   if (const json* v = find(root, "contact")) contact(*v, join(top, "contact"));
   if (const json* v = find(root, "timestep")) {
@@ -414,7 +447,7 @@ void Reader::mobile(const json& root) {
     spec_.timestep = dt;
   }
   if (const json* v = find(root, "joint_tolerance"))
-    spec_.joint_tolerance = positive(*v, join(top, "joint_tolerance"), "m");
+    spec_.joint_tolerance = length(*v, join(top, "joint_tolerance"));
 
   const Path cp = join(top, "components");
   const json& list = require(root, top, "components", "a non-empty array of components");
@@ -443,12 +476,12 @@ WindSourceSpec Reader::wind_source(const json& v, const Path& path, std::size_t 
   w.path = path.str();
   w.name = "source " + std::to_string(index + 1);
   if (const json* x = find(v, "name")) w.name = text(*x, join(path, "name"));
-  w.from = vec3(require(v, path, "from", "[x, y, z] in m: the centre of the source's disc S0"), join(path, "from"), "m");
-  w.to = vec3(require(v, path, "to", "[x, y, z] in m: a point it blows towards"), join(path, "to"), "m");
+  w.from = point(require(v, path, "from", "[x, y, z] in m: the centre of the source's disc S0"), join(path, "from"));
+  w.to = point(require(v, path, "to", "[x, y, z] in m: a point it blows towards"), join(path, "to"));
   if (!((w.to - w.from).norm() > 0))
     fail(join(path, "to"), "must differ from \"from\" (the wind blows from \"from\" towards \"to\")");
-  if (const json* x = find(v, "r0")) w.r0 = positive(*x, join(path, "r0"), "m, the radius of the disc S0");
-  if (const json* x = find(v, "l0")) w.l0 = positive(*x, join(path, "l0"), "m, from the cone's vertex to S0");
+  if (const json* x = find(v, "r0")) w.r0 = length(*x, join(path, "r0"), "m, the radius of the disc S0");
+  if (const json* x = find(v, "l0")) w.l0 = length(*x, join(path, "l0"), "m, from the cone's vertex to S0");
   const Path sp = join(path, "speed");
   const json& speed = require(v, path, "speed", "m/s, the wind speed v0 at the disc S0");
   w.speed = speed.is_number() ? speed.get<double>() : -1;
@@ -511,9 +544,9 @@ CameraSpec Reader::camera(const json& v, const Path& path) const {
   CameraSpec c;
   if (const json* x = find(v, "yaw")) c.yaw_deg = number(*x, join(path, "yaw"), "degrees");
   if (const json* x = find(v, "pitch")) c.pitch_deg = in_range(*x, join(path, "pitch"), -85, 85, "degrees");
-  if (const json* x = find(v, "distance")) c.distance = positive(*x, join(path, "distance"), "m");
+  if (const json* x = find(v, "distance")) c.distance = length(*x, join(path, "distance"));
   if (const json* x = find(v, "fov")) c.fov_deg = in_range(*x, join(path, "fov"), 5, 120, "degrees");
-  if (const json* x = find(v, "target")) c.target = vec3(*x, join(path, "target"), "m");
+  if (const json* x = find(v, "target")) c.target = point(*x, join(path, "target"));
   return c;
 }
 
@@ -528,7 +561,8 @@ void Reader::balance(const json& v, const Path& path) {
     else if (*m == "none") b.mode = BalanceMode::None;
     else fail(mp, "must be \"mass\", \"joints\" or \"none\", got " + describe(*m));
   }
-  if (const json* t = find(v, "total_mass")) b.total_mass = positive(*t, join(path, "total_mass"), "kg");
+  if (const json* t = find(v, "total_mass"))
+    b.total_mass = in_range(*t, join(path, "total_mass"), kLightestMobile, kHeaviestMobile, "kg");
   if (b.mode == BalanceMode::Mass && !b.total_mass)
     fail(path, "missing key \"total_mass\" (kg of the moving components: balance mode \"mass\" needs it)");
   spec_.balance = b;
@@ -557,7 +591,7 @@ ComponentSpec Reader::component(const json& v, const Path& path) {
   c.name = text(require(v, path, "name", "the component's name, a string"), join(path, "name"));
   if (const json* x = find(v, "fixed")) c.fixed = boolean(*x, join(path, "fixed"));
   if (const json* x = find(v, "parent")) c.parent = text(*x, join(path, "parent"));
-  if (const json* x = find(v, "joint")) c.joint = vec3(*x, join(path, "joint"), "m");
+  if (const json* x = find(v, "joint")) c.joint = point(*x, join(path, "joint"));
   if (c.fixed) {
     if (c.parent) fail(join(path, "parent"), "a fixed component hangs from nothing: remove \"parent\" or \"fixed\"");
     if (c.joint) fail(join(path, "joint"), "a fixed component hangs from nothing: remove \"joint\" or \"fixed\"");
@@ -573,7 +607,7 @@ ComponentSpec Reader::component(const json& v, const Path& path) {
   c.shapes.reserve(shapes.size());
   for (std::size_t i = 0; i < shapes.size(); ++i) c.shapes.push_back(shape(shapes[i], item(sp, i)));
   if (const json* x = find(v, "color")) c.color = color(*x, join(path, "color"));
-  if (const json* x = find(v, "density")) c.density = positive(*x, join(path, "density"), "kg/m^3");
+  if (const json* x = find(v, "density")) c.density = density(*x, join(path, "density"));
   if (const json* x = find(v, "restitution")) c.restitution = fraction(*x, join(path, "restitution"));
   if (const json* x = find(v, "friction")) c.friction = non_negative(*x, join(path, "friction"), "");
   return c;
@@ -623,7 +657,7 @@ ShapeSpec Reader::shape(const json& v, const Path& path) {
   else if (kinds[0] == "box") s.shape = box(body, kp);
   else if (kinds[0] == "plate") s.shape = plate(body, kp);
   else s.shape = mesh(body, kp);
-  if (const json* x = find(v, "density")) s.density = positive(*x, join(path, "density"), "kg/m^3");
+  if (const json* x = find(v, "density")) s.density = density(*x, join(path, "density"));
   return s;
 }
 
@@ -631,8 +665,8 @@ Sphere Reader::sphere(const json& v, const Path& path) const {
   object(v, path, "with \"center\" and \"radius\"");
   check_keys(v, path, format_keys::kSphere);
   Sphere s;
-  s.center = vec3(require(v, path, "center", "[x, y, z] in m"), join(path, "center"), "m");
-  s.radius = positive(require(v, path, "radius", "m, a positive number"), join(path, "radius"), "m");
+  s.center = point(require(v, path, "center", "[x, y, z] in m"), join(path, "center"));
+  s.radius = length(require(v, path, "radius", "m, a positive number"), join(path, "radius"));
   return s;
 }
 
@@ -640,9 +674,9 @@ Wire Reader::wire(const json& v, const Path& path) const {
   object(v, path, "with \"from\", \"to\" and \"radius\"");
   check_keys(v, path, format_keys::kWire);
   Wire w;
-  w.from = vec3(require(v, path, "from", "[x, y, z] in m"), join(path, "from"), "m");
-  w.to = vec3(require(v, path, "to", "[x, y, z] in m"), join(path, "to"), "m");
-  w.radius = positive(require(v, path, "radius", "m, a positive number"), join(path, "radius"), "m");
+  w.from = point(require(v, path, "from", "[x, y, z] in m"), join(path, "from"));
+  w.to = point(require(v, path, "to", "[x, y, z] in m"), join(path, "to"));
+  w.radius = length(require(v, path, "radius", "m, a positive number"), join(path, "radius"));
   if (!((w.to - w.from).norm() > 0)) fail(join(path, "to"), "must differ from \"from\" (a wire needs a length > 0)");
   return w;
 }
@@ -651,8 +685,8 @@ Box Reader::box(const json& v, const Path& path) const {
   object(v, path, "with \"center\", \"size\" and optionally \"rotation\"");
   check_keys(v, path, format_keys::kBox);
   Box b;
-  b.center = vec3(require(v, path, "center", "[x, y, z] in m"), join(path, "center"), "m");
-  b.size = positive_vec3(require(v, path, "size", "[sx, sy, sz] full edge lengths in m"), join(path, "size"), "m");
+  b.center = point(require(v, path, "center", "[x, y, z] in m"), join(path, "center"));
+  b.size = lengths(require(v, path, "size", "[sx, sy, sz] full edge lengths in m"), join(path, "size"));
   if (const json* r = find(v, "rotation")) {
     const Path rp = join(path, "rotation");
     object(*r, rp, "with \"axis\" [x, y, z] and \"degrees\"");
@@ -677,9 +711,9 @@ Plate Reader::plate(const json& v, const Path& path) const {
     const json& q = points[i];
     const Path qp = item(pp, i);
     if (!q.is_array() || q.size() != 2) fail(qp, "must be a point [u, v] of 2 numbers (m), got " + describe(q));
-    p.points.emplace_back(number(q[0], item(qp, 0), "m"), number(q[1], item(qp, 1), "m"));
+    p.points.emplace_back(coordinate(q[0], item(qp, 0)), coordinate(q[1], item(qp, 1)));
   }
-  p.thickness = positive(require(v, path, "thickness", "m, a positive number"), join(path, "thickness"), "m");
+  p.thickness = length(require(v, path, "thickness", "m, a positive number"), join(path, "thickness"));
 
   const Path lp = join(path, "plane");
   const json& plane = require(v, path, "plane", "\"xy\", \"yz\", \"xz\" or {\"origin\", \"u\", \"v\"}");
@@ -699,7 +733,7 @@ Plate Reader::plate(const json& v, const Path& path) const {
                                   " the plane's offset is \"" + std::string(named->offset) + "\")");
     }
     double offset = 0;
-    if (const json* o = find(v, named->offset)) offset = number(*o, join(path, named->offset), "m");
+    if (const json* o = find(v, named->offset)) offset = coordinate(*o, join(path, named->offset));
     p.origin = offset * named->normal;
     p.u_axis = named->u;
     p.v_axis = named->v;
@@ -710,7 +744,7 @@ Plate Reader::plate(const json& v, const Path& path) const {
         fail_key(path, other, "unknown key " + quote_json(other) +
                                   " (a plane given by origin, u and v has no offset: move its origin)");
     }
-    p.origin = vec3(require(plane, lp, "origin", "[x, y, z] in m"), join(lp, "origin"), "m");
+    p.origin = point(require(plane, lp, "origin", "[x, y, z] in m"), join(lp, "origin"));
     const Vec3 u = nonzero_vec3(require(plane, lp, "u", "[x, y, z], the direction of the first coordinate"), join(lp, "u"));
     const Vec3 w = nonzero_vec3(require(plane, lp, "v", "[x, y, z], the direction of the second coordinate"), join(lp, "v"));
     p.u_axis = u.stableNormalized();
@@ -741,7 +775,7 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
     else if (s->is_number()) scale = Vec3::Constant(positive(*s, sp, ""));
     else fail(sp, "must be a positive number or [sx, sy, sz] of positive numbers, got " + describe(*s));
   }
-  if (const json* t = find(v, "translate")) translate = vec3(*t, join(path, "translate"), "m");
+  if (const json* t = find(v, "translate")) translate = point(*t, join(path, "translate"));
 
   const std::string resolved = (fs::path(base_dir_) / fs::path(m.file)).lexically_normal().string();
   std::error_code ec;
@@ -753,7 +787,13 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   } catch (const InputError& e) {
     fail(op, e.what());
   }
-  for (Vec3& p : m.mesh.vertices) p = p.cwiseProduct(scale) + translate;  // scale, then translate
+  for (Vec3& p : m.mesh.vertices) {
+    p = p.cwiseProduct(scale) + translate;  // scale, then translate
+    if (!(p.cwiseAbs().maxCoeff() <= kLongestLength))  // (NaN fails too)
+      fail(op, resolved + ": a vertex lies at [" + format_number(p.x()) + ", " + format_number(p.y()) + ", " +
+                   format_number(p.z()) + "] m once scaled and moved, more than " + format_number(kLongestLength) +
+                   " m from the origin (no mobile is larger)");
+  }
   if (auto problem = closed_mesh_problem(m.mesh)) fail(op, resolved + ": " + *problem);
   return m;
 }

@@ -228,7 +228,7 @@ TEST(Parse, BalanceModes) {
   expect_error(head + "\n{}}", "balance", 4, "missing key \"total_mass\"");
   expect_error(head + "\n{\"mode\": \"heavy\"}}", "balance.mode", 4, "must be \"mass\", \"joints\" or \"none\"");
   expect_error(head + "\n{\"mode\": \"none\", \"total_mass\": 0}}", "balance.total_mass", 4,
-               "must be a positive number (kg), got 0");
+               "must be a number from 1e-06 to 1e+06 (kg), got 0");
 }
 
 TEST(Parse, SyntaxErrorHasLineAndPlainMessage) {
@@ -446,6 +446,50 @@ TEST(Parse, MeshOpen) {
           "obj": "open.obj"}})");
   expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "open.obj"), "open.obj: ",
                dir.path().string());
+}
+
+// Sizes no mobile has (aloft/spec.hpp: kLongestLength, the total mass and density ranges) are refused
+// where they stand: far beyond them the step and the collision tests break. The first case is what
+// fuzz_mobile_simulate found: a hook sphere of radius 5.6e128 m crashed libccd when the pairs were pruned.
+TEST(Parse, SizesBeyondAnyMobileAreRefused) {
+  const std::string huge_hook = R"({
+  "name": "test",
+  "components": [
+    {"name": "hook", "fixed": true,
+     "shapes": [{"sphere": {"center": [0, 2, 0], "radius": 5.6e128}}]},
+    {"name": "thing", "parent": "hook", "joint": [0, 2, 0],
+     "shapes": [{"sphere": {"center": [0, 1.5, 0], "radius": 0.1}}]}
+  ]
+})";
+  expect_error(huge_hook, "components[0].shapes[0].sphere.radius", line_of(huge_hook, "5.6e128"),
+               "must be at most 1000 m (no mobile is larger), got 5.6e+128");
+  const std::string far = with_shape(R"({"box": {"center": [0, 1, 0],
+          "size": [0.1, 1001, 0.1]}})");
+  expect_error(far, "components[1].shapes[0].box.size[1]", line_of(far, "1001"), "must be at most 1000 m");
+  const std::string away = with_shape(R"({"wire": {"from": [0, 1, 0],
+          "to": [0, -2e3, 0], "radius": 0.001}})");
+  expect_error(away, "components[1].shapes[0].wire.to[1]", line_of(away, "-2e3"),
+               "must be from -1000 to 1000 m (no mobile is larger), got -2000");
+  const std::string dense = with_shape(R"({"sphere": {"center": [0, 1, 0], "radius": 0.1},
+          "density": 1e300})");
+  expect_error(dense, "components[1].shapes[0].density", line_of(dense, "1e300"),
+               "must be a number from 0.001 to 1e+06 (kg/m^3), got 1e+300");
+  const std::string heavy = R"({"name": "test", "balance": {"mode": "mass",
+  "total_mass": 1e300}, "components": []})";
+  expect_error(heavy, "balance.total_mass", 2, "must be a number from 1e-06 to 1e+06 (kg), got 1e+300");
+  // Lengths at the bounds themselves are taken.
+  EXPECT_NO_THROW(parse_mobile_text(with_shape(R"({"box": {"center": [0, -1000, 0], "size": [1000, 1000, 1000]}})"),
+                                    "mobiles/test.json"));
+}
+
+// An OBJ mesh's vertices, once scaled and moved, keep within kLongestLength of the origin too.
+TEST(Parse, MeshScaledBeyondAnyMobileIsRefused) {
+  TempDir dir;
+  dir.write("tet.obj", std::string(kTetrahedronVertices) + kTetrahedronFaces);
+  const std::string text = with_shape(R"({"mesh": {"obj": "tet.obj",
+          "scale": 1e6}})");
+  expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "tet.obj"),
+               "once scaled and moved, more than 1000 m from the origin (no mobile is larger)", dir.path().string());
 }
 
 TEST(Parse, MeshMalformedLine) {
