@@ -103,6 +103,13 @@ inline constexpr double kHeaviestMobile = 1e6;
 //   ratios) to 1e6 (forty times osmium's).
 inline constexpr double kLeastDensity = 1e-3;
 inline constexpr double kGreatestDensity = 1e6;
+// - Gravity (m/s^2): each coordinate at most 100 in size, ten times Earth's (any planet's surface has
+//   less than 25; 1e300 made the balance fail with a message about something else).
+inline constexpr double kStrongestGravity = 100.0;
+// - Air damping rates (1/s): at most 100. The damping is an explicit force (step_workspace.hpp), stable
+//   while rate * h < 2, so this holds for every timestep a file may ask (h <= 0.01 s); air gives
+//   0.01-0.1 (1e300 went non-finite at step 2).
+inline constexpr double kGreatestDampingRate = 100.0;
 
 // The fastest wind v0 at S0 (m/s) that the mobile file, the command line and a speed series may ask for.
 // The cone's continuity (eq. 2) and drag (eqs. 3-4) treat the air as incompressible, which holds to a few

@@ -431,7 +431,13 @@ void Reader::mobile(const json& root) {
   }
   check_keys(root, top, format_keys::kMobile);
   spec_.name = text(require(root, top, "name", "the mobile's name, a string"), join(top, "name"));
-  if (const json* v = find(root, "gravity")) spec_.gravity = vec3(*v, join(top, "gravity"), "m/s^2");
+  if (const json* v = find(root, "gravity")) {
+    const Path gp = join(top, "gravity");
+    if (!v->is_array() || v->size() != 3)
+      fail(gp, "must be an array of 3 numbers [x, y, z] (m/s^2), got " + describe(*v));
+    for (int k = 0; k < 3; ++k)
+      spec_.gravity[k] = in_range((*v)[k], item(gp, k), -kStrongestGravity, kStrongestGravity, "m/s^2");
+  }
   if (const json* v = find(root, "balance")) {
     balance(*v, join(top, "balance"));
   } else {
@@ -571,8 +577,10 @@ void Reader::balance(const json& v, const Path& path) {
 void Reader::damping(const json& v, const Path& path) {
   object(v, path, "with \"linear\" and \"angular\" in 1/s");
   check_keys(v, path, format_keys::kDamping);
-  if (const json* x = find(v, "linear")) spec_.damping.linear = non_negative(*x, join(path, "linear"), "1/s");
-  if (const json* x = find(v, "angular")) spec_.damping.angular = non_negative(*x, join(path, "angular"), "1/s");
+  if (const json* x = find(v, "linear"))
+    spec_.damping.linear = in_range(*x, join(path, "linear"), 0, kGreatestDampingRate, "1/s");
+  if (const json* x = find(v, "angular"))
+    spec_.damping.angular = in_range(*x, join(path, "angular"), 0, kGreatestDampingRate, "1/s");
 }
 
 void Reader::contact(const json& v, const Path& path) {

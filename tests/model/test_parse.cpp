@@ -477,6 +477,12 @@ TEST(Parse, SizesBeyondAnyMobileAreRefused) {
   const std::string heavy = R"({"name": "test", "balance": {"mode": "mass",
   "total_mass": 1e300}, "components": []})";
   expect_error(heavy, "balance.total_mass", 2, "must be a number from 1e-06 to 1e+06 (kg), got 1e+300");
+  const std::string crushing = R"({"name": "test", "gravity": [0,
+  -1e300, 0], "components": []})";
+  expect_error(crushing, "gravity[1]", 2, "must be a number from -100 to 100 (m/s^2), got -1e+300");
+  const std::string thick_air = R"({"name": "test", "damping": {"linear": 0.1,
+  "angular": 1e300}, "components": []})";
+  expect_error(thick_air, "damping.angular", 2, "must be a number from 0 to 100 (1/s), got 1e+300");
   // Lengths at the bounds themselves are taken.
   EXPECT_NO_THROW(parse_mobile_text(with_shape(R"({"box": {"center": [0, -1000, 0], "size": [1000, 1000, 1000]}})"),
                                     "mobiles/test.json"));
