@@ -12,7 +12,8 @@
 namespace aloft::test {
 
 // Makes, empty, and returns <system temp>/aloft-<label>-<test name>-<process id>. Call it from a test
-// or its fixture; the caller removes it (fs::remove_all) when done.
+// or its fixture, once per label (a second call empties the same directory); the caller removes it
+// (fs::remove_all) when done.
 inline std::filesystem::path make_test_dir(const std::string& label) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::filesystem::path dir =
