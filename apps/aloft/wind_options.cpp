@@ -64,10 +64,6 @@ WindSettings settings_from_flags(const WindOptions& o) {
   return settings;
 }
 
-int refresh_steps(const WindOptions& o, double timestep) {
-  return std::max(1, static_cast<int>(std::lround(1.0 / (o.refresh * timestep))));
-}
-
 std::string profile_text(const WindProfileSpec& p) {
   switch (p.kind) {
     case WindProfileKind::Steady: return "steady";
@@ -195,7 +191,7 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
   } catch (const std::invalid_argument& e) {
     throw Failure(e.what());
   }
-  d.refresh_every = refresh_steps(o, timestep);
+  d.refresh_every = occlusion_refresh_steps(o.refresh, timestep);
 
   std::string speed;
   if (o.constant) {
@@ -236,7 +232,7 @@ WindDriver make_file_wind(const Model& model, const WindSourceSpec& source, std:
     throw Failure(model.file + ": " + source.path + ": " + e.what());
   }
   d.file_source = source;
-  d.refresh_every = refresh_steps(o, timestep);
+  d.refresh_every = occlusion_refresh_steps(o.refresh, timestep);
   d.description = format("\"%s\" (file): v0 = %g m/s, %s; S0 at %s r0 = %.3g m, l0 = %.3g m, towards %s; "
                          "alpha = %.3g kg m, beta = %g",
                          source.name.c_str(), source.speed, profile_text(source.profile).c_str(),

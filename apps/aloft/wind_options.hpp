@@ -28,7 +28,7 @@ struct WindOptions {
   long long seed = 1;
   int resolution = 256;
   int tile = 8;
-  double refresh = 60;                 // Hz
+  double refresh = kOcclusionRefreshRate;  // Hz
   double gain = EnvelopeSettings{}.gain;
   double noise_floor = -1;             // RMS; < 0: calibrate from the first --wind-calibrate seconds
   double calibrate = 1.0;              // s

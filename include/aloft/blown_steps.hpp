@@ -6,7 +6,7 @@
 // The wind is the command line's default one (`aloft simulate --wind V0`): S0 1.5 m in front (+z) of the
 // mobile as it stands when the steps are made, blowing along -z, its cone just covering the mobile
 // (source_facing_mobile), l0 = 1 m, the default WindSettings (turbulence beta 0.3, seed 1), and the
-// occlusion refreshed at 60 Hz (every 17 steps of 1 ms).
+// occlusion refreshed at kOcclusionRefreshRate, 60 Hz (every 17 steps of 1 ms).
 
 #include <memory>
 
@@ -34,8 +34,6 @@ class BlownSteps {
   double wind_seconds() const { return timer_ ? timer_->taken_from_span() : 0.0; }
   // The wind's own CPU time (s) so far, without the clock's reads.
   double wind_work_seconds() const { return timer_ ? timer_->work_seconds() : 0.0; }
-
-  static constexpr double kRefreshRate = 60;  // Hz: occlusion refreshes, as `aloft simulate`'s default
 
  private:
   Simulation& sim_;

@@ -60,6 +60,13 @@ struct WindSource {
   void validate() const;
 };
 
+// How often the occlusion is refreshed unless asked otherwise (Hz of simulated time): the command
+// line's --wind-refresh, the viewer and the benchmarks' blown steps. The mobile moves little in 1/60 s.
+inline constexpr double kOcclusionRefreshRate = 60;
+
+// Steps between occlusion refreshes at `rate` (Hz) with steps of h (s): 1 / (rate h) rounded, at least 1.
+int occlusion_refresh_steps(double rate, double h);
+
 // A sphere around the whole mobile at `state`: centred on the world box of every shape's corners, its
 // radius the box's half diagonal (m). What the sources below are sized to cover.
 struct MobileSphere {

@@ -2,9 +2,8 @@
 
 #include "aloft/blown_steps.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "aloft/spec.hpp"
 
@@ -16,7 +15,7 @@ BlownSteps::BlownSteps(const Model& model, Simulation& sim, double v0) : sim_(si
   v0_ = v0;
   wind_ = std::make_unique<Wind>(model, source_facing_mobile(model, sim.state(), Vec3(0, 0, -1), 1.5, 1.0),
                                  WindSettings{});
-  refresh_every_ = std::max(1, static_cast<int>(std::lround(1.0 / (kRefreshRate * sim.timestep()))));
+  refresh_every_ = occlusion_refresh_steps(kOcclusionRefreshRate, sim.timestep());
   timer_ = std::make_unique<ApartTimer>();
 }
 

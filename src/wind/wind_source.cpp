@@ -60,6 +60,10 @@ void WindSettings::validate() const {
                                 std::to_string(round_segments));
 }
 
+int occlusion_refresh_steps(double rate, double h) {
+  return std::max(1, static_cast<int>(std::lround(1.0 / (rate * h))));
+}
+
 MobileSphere mobile_sphere(const Model& model, const State& state) {
   Bounds world;  // of the corners of every shape's body-frame box, carried to the world
   for (int c = 0; c < model.count; ++c) {

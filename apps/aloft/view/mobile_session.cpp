@@ -20,9 +20,9 @@ using Clock = WallClock;
 // far below the step's stability limit 2/h.
 constexpr double kGrabStiffnessPerKg = 60;
 
-// Wind occlusion is refreshed at this rate of simulated time (as the wind API suggests): the mobile moves
-// little in 1/60 s, and between refreshes the elements follow their components.
-constexpr double kOcclusionInterval = 1.0 / 60;
+// Wind occlusion is refreshed at this rate of simulated time (kOcclusionRefreshRate, wind.hpp): the
+// mobile moves little in 1/60 s, and between refreshes the elements follow their components.
+constexpr double kOcclusionInterval = 1.0 / kOcclusionRefreshRate;
 
 bool same_pose(const Model& a, const Model& b) {
   if (a.count != b.count) return false;
