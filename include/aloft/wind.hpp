@@ -64,7 +64,8 @@ struct WindSource {
 // line's --wind-refresh, the viewer and the benchmarks' blown steps. The mobile moves little in 1/60 s.
 inline constexpr double kOcclusionRefreshRate = 60;
 
-// Steps between occlusion refreshes at `rate` (Hz) with steps of h (s): 1 / (rate h) rounded, at least 1.
+// Steps between occlusion refreshes at `rate` (Hz) with steps of h (s): 1 / (rate h) rounded, at least 1
+// and at most INT_MAX (a rate so low that the occlusion is looked at only once, at the first step).
 int occlusion_refresh_steps(double rate, double h);
 
 // A sphere around the whole mobile at `state`: centred on the world box of every shape's corners, its

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -61,7 +62,9 @@ void WindSettings::validate() const {
 }
 
 int occlusion_refresh_steps(double rate, double h) {
-  return std::max(1, static_cast<int>(std::lround(1.0 / (rate * h))));
+  // Clamped as a double: the cast of a count beyond int (1e-300 Hz) is undefined, and gave 1, every step.
+  const double steps = std::round(1.0 / (rate * h));
+  return static_cast<int>(std::clamp(steps, 1.0, static_cast<double>(std::numeric_limits<int>::max())));
 }
 
 MobileSphere mobile_sphere(const Model& model, const State& state) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "aloft/geometry.hpp"
@@ -216,6 +217,16 @@ TEST(WindSource, SourcesFacingTheMobileCoverItsWholeSphere) {
   EXPECT_NEAR((aimed.disc_center() - from).norm(), 0, 1e-12);
   EXPECT_TRUE(holds_sphere(aimed));
   EXPECT_NEAR(std::asin(cover.radius / (cover.center - aimed.vertex).norm()), aimed.half_angle(), 1e-9);
+}
+
+// Steps between occlusion refreshes: 1 / (rate h) rounded, at least one step, and at most INT_MAX for a
+// rate too low to refresh again in any run (1e-300 Hz: the cast of 1e303 to int gave 1, every step).
+TEST(WindSource, OcclusionRefreshStepsRoundAndSaturate) {
+  EXPECT_EQ(occlusion_refresh_steps(kOcclusionRefreshRate, 0.001), 17);  // 16.67 rounded
+  EXPECT_EQ(occlusion_refresh_steps(100, 0.001), 10);
+  EXPECT_EQ(occlusion_refresh_steps(1e6, 0.001), 1);  // faster than the steps: every step
+  EXPECT_EQ(occlusion_refresh_steps(1e-300, 0.001), std::numeric_limits<int>::max());
+  EXPECT_EQ(occlusion_refresh_steps(1e-6, 0.001), 1000000000);
 }
 
 }  // namespace
