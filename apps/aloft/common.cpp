@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 namespace aloft::cli {
@@ -92,23 +93,34 @@ std::optional<double> read_number(const std::string& input) {
 
 namespace {
 
-// A finite number above `lo`, or at it too when `lo_allowed`; otherwise "must be <rule>, got X".
-CLI::Validator finite_number_above(double lo, bool lo_allowed, std::string rule) {
+// A finite number above `lo` (or at it too when `lo_allowed`) and at most `hi`; otherwise "must be <rule>,
+// got X".
+CLI::Validator finite_number_between(double lo, bool lo_allowed, double hi, std::string rule) {
   return CLI::Validator(
-      [lo, lo_allowed, rule](std::string& input) -> std::string {
+      [lo, lo_allowed, hi, rule](std::string& input) -> std::string {
         const std::optional<double> v = read_number(input);
         if (!v) return "must be a number, got \"" + input + "\"";
-        if (!std::isfinite(*v) || !(*v > lo || (lo_allowed && *v == lo))) return "must be " + rule + ", got " + input;
+        if (!std::isfinite(*v) || !(*v > lo || (lo_allowed && *v == lo)) || *v > hi)
+          return "must be " + rule + ", got " + input;
         return {};
       },
       "");
 }
 
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
 }  // namespace
 
-CLI::Validator positive_number() { return finite_number_above(0, false, "a positive number"); }
+CLI::Validator positive_number() { return finite_number_between(0, false, kInfinity, "a positive number"); }
 
-CLI::Validator non_negative_number() { return finite_number_above(0, true, "a number >= 0"); }
+CLI::Validator non_negative_number() { return finite_number_between(0, true, kInfinity, "a number >= 0"); }
+
+CLI::Validator finite_number() { return finite_number_between(-kInfinity, false, kInfinity, "a finite number"); }
+
+CLI::Validator length_in_metres() {
+  return finite_number_between(0, false, kLongestLength,
+                               format("a positive number of at most %g (m; no mobile is larger)", kLongestLength));
+}
 
 CLI::Validator number_in(double lo, double hi) {
   return CLI::Validator(

@@ -87,6 +87,8 @@ std::optional<double> read_number(const std::string& input);
 // Validators with clear messages ("must be ..., got \"X\""), in the words the option's help uses.
 CLI::Validator positive_number();          // > 0
 CLI::Validator non_negative_number();      // >= 0
+CLI::Validator finite_number();            // any number but inf and nan
+CLI::Validator length_in_metres();         // (0, kLongestLength]: the mobile file's rule for lengths (spec.hpp)
 CLI::Validator number_in(double lo, double hi);  // a number in [lo, hi]
 CLI::Validator timestep_range();           // (0, 0.01]
 CLI::Validator integer_in(long long lo, long long hi);  // an integer in [lo, hi]

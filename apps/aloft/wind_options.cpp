@@ -28,12 +28,26 @@ std::optional<Vec3> read_point(const std::string& text) {
   return p;
 }
 
+// A point x,y,z (m) within the mobile file's rule for coordinates (spec.hpp: kLongestLength).
 CLI::Validator point_validator() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        return read_point(input) ? std::string() : "must be a point x,y,z in metres, got \"" + input + "\"";
+        const std::optional<Vec3> p = read_point(input);
+        if (!p) return "must be a point x,y,z in metres, got \"" + input + "\"";
+        if (p->cwiseAbs().maxCoeff() > kLongestLength)
+          return format("must be a point x,y,z with each coordinate from -%g to %g m (no mobile is larger), got \"",
+                        kLongestLength, kLongestLength) +
+                 input + "\"";
+        return {};
       },
       "");
+}
+
+// --wind-alpha against --wind-l0 for the flags' own wind (the rule needs both, so it is checked once the
+// command line is read). Without one, --wind-alpha is only for the file's sources: make_file_wind checks it.
+void check_alpha_against_l0(const WindOptions& o) {
+  if (o.any() && o.alpha > 0 && !acceptable_wind_alpha(o.alpha, o.l0))
+    throw CLI::ValidationError("--wind-alpha", wind_alpha_rule(o.l0) + ", got " + format("%g", o.alpha));
 }
 
 }  // namespace
@@ -105,20 +119,22 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
       ->type_name("X,Y,Z")
       ->check(point_validator())
       ->group(group);
-  sub->add_option("--wind-r0", o.r0, "Radius of S0 (m, > 0); default: the cone just covers the mobile")
+  sub->add_option("--wind-r0", o.r0, "Radius of S0 (m, > 0, up to 1000); default: the cone just covers the mobile")
       ->type_name("R0")
-      ->check(positive_number())
+      ->check(length_in_metres())
       ->group(group);
-  sub->add_option("--wind-l0", o.l0, "Distance from the cone's vertex to S0 (m, > 0)")
+  sub->add_option("--wind-l0", o.l0, "Distance from the cone's vertex to S0 (m, > 0, up to 1000)")
       ->type_name("L0")
       ->capture_default_str()
-      ->check(positive_number())
+      ->check(length_in_metres())
       ->group(group);
   sub->add_option("--wind-alpha", o.alpha,
-                  "Drag constant alpha of F = alpha A v0^2 / l1^4 cos (kg m, > 0); default: air, 1.204 * l0^4")
+                  "Drag constant alpha of F = alpha A v0^2 / l1^4 cos (kg m, > 0, up to water's 1000 * l0^4); "
+                  "default: air, 1.204 * l0^4")
       ->type_name("A")
       ->check(positive_number())
       ->group(group);
+  sub->parse_complete_callback([&o] { check_alpha_against_l0(o); });
   sub->add_option("--wind-beta", o.beta, "Turbulence: |F_random| < beta |F_stoke| (0: none, up to 10)")
       ->type_name("B")
       ->capture_default_str()
@@ -223,6 +239,9 @@ WindDriver make_file_wind(const Model& model, const WindSourceSpec& source, std:
                           double timestep) {
   WindSettings settings = settings_from_flags(o);
   if (source.alpha) settings.alpha = *source.alpha;
+  else if (o.alpha > 0 && !acceptable_wind_alpha(o.alpha, source.l0))  // the flag's alpha, for this source's l0
+    throw Failure(model.file + ": " + source.path + " (l0 = " + format("%g", source.l0) +
+                  " m) takes --wind-alpha, which " + wind_alpha_rule(source.l0) + ", got " + format("%g", o.alpha));
   if (source.beta) settings.beta = *source.beta;
   settings.seed = source.seed ? *source.seed : static_cast<std::uint64_t>(o.seed) + 1 + index;
   WindDriver d;

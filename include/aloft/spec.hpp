@@ -124,6 +124,22 @@ inline constexpr double kFastestWind = 100.0;
 bool acceptable_wind_speed(double v0);
 std::string wind_speed_rule();
 
+// Density of air at 20 C, sea level (kg/m^3): a wind's default alpha is kAirDensity * l0^4 (wind.hpp).
+inline constexpr double kAirDensity = 1.204;
+
+// The densest fluid a wind's alpha may stand for (kg/m^3): water's. Eq. 4's alpha is rho * l0^4 (kg m,
+// docs/wind.md) and the paper leaves it a free constant, so a file or the command line may blow harder
+// than air, up to 830 times air's drag. Beyond that no wind is meant: alpha 1e20 kg m made the Steel
+// Fish spin past the step-size rule in its first step, and 1e300 made that step non-finite, with
+// messages that did not name alpha.
+inline constexpr double kDensestWind = 1000.0;
+
+// Whether an alpha (kg m) from outside keeps the rule for a source whose vertex is l0 (m) behind S0
+// (0 < alpha <= kDensestWind * l0^4), and the rule worded for an error message that names where alpha
+// came from and ends with what it was: "<place>: must be a positive number of at most ..., got 1e300".
+bool acceptable_wind_alpha(double alpha, double l0);
+std::string wind_alpha_rule(double l0);
+
 // A wind source the file places in the room (a fan, an air vent): the paper's cone with its disc S0
 // centred at `from`, blowing towards `to`, the vertex l0 behind S0 (WindSource::aimed(from, to, r0, l0)).
 struct WindSourceSpec {
@@ -135,7 +151,7 @@ struct WindSourceSpec {
   double speed = 0;                         // v0 at S0 at full strength, m/s (0 to kFastestWind)
   WindProfileSpec profile;
   // Per-source overrides of the wind's settings (WindSettings); empty: the run's value.
-  std::optional<double> alpha;              // kg m (> 0); run default: air, kAirDensity * l0^4
+  std::optional<double> alpha;              // kg m (0 < alpha <= kDensestWind * l0^4); run default: air, kAirDensity * l0^4
   std::optional<double> beta;               // turbulence bound, 0..10
   std::optional<std::uint64_t> seed;        // of the turbulence
   std::string path;                         // e.g. "wind_sources[0]"

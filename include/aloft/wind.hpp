@@ -42,9 +42,6 @@ namespace internal {
 class ItemRasterizer;
 }
 
-// Density of air at 20 C, sea level (kg/m^3).
-inline constexpr double kAirDensity = 1.204;
-
 // The cone of wind. S0 is the disc of radius r0, centred at vertex + l0 * direction, facing `direction`.
 struct WindSource {
   Vec3 vertex = Vec3(0, 1.8, 3.0);     // cone vertex, world, m

@@ -493,7 +493,11 @@ WindSourceSpec Reader::wind_source(const json& v, const Path& path, std::size_t 
   w.speed = speed.is_number() ? speed.get<double>() : -1;
   if (!speed.is_number() || !acceptable_wind_speed(w.speed)) fail(sp, wind_speed_rule() + ", got " + describe(speed));
   if (const json* x = find(v, "profile")) w.profile = wind_profile(*x, join(path, "profile"));
-  if (const json* x = find(v, "alpha")) w.alpha = positive(*x, join(path, "alpha"), "kg m");
+  if (const json* x = find(v, "alpha")) {  // after l0: alpha's bound is water's density times l0^4
+    if (!x->is_number() || !acceptable_wind_alpha(x->get<double>(), w.l0))
+      fail(join(path, "alpha"), wind_alpha_rule(w.l0) + ", got " + describe(*x));
+    w.alpha = x->get<double>();
+  }
   if (const json* x = find(v, "beta")) w.beta = in_range(*x, join(path, "beta"), 0, 10, "");
   if (const json* x = find(v, "seed")) w.seed = count(*x, join(path, "seed"));
   return w;

@@ -1,11 +1,8 @@
 // The time profile of a wind source placed by a mobile file (spec.hpp): steady, switched on and off, or
-// swelling like a vent that breathes; and the fastest wind speed a run is given.
+// swelling like a vent that breathes.
 
-#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
-#include <string>
 
 #include "aloft/spec.hpp"
 
@@ -24,14 +21,5 @@ double WindProfileSpec::factor(double t) const {
   if (ramp > 0 && cycle < on + ramp) return 1 - (cycle - on) / ramp;
   return 0;
 }
-
-std::string wind_speed_rule() {
-  char text[64];
-  std::snprintf(text, sizeof text, "must be from 0 to %g m/s", kFastestWind);
-  return std::string(text) +
-         " (the cone model treats the air as incompressible, which holds below about 0.3 of the speed of sound)";
-}
-
-bool acceptable_wind_speed(double v0) { return v0 >= 0 && v0 <= kFastestWind; }
 
 }  // namespace aloft

@@ -289,9 +289,26 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
        "--wind-noise-floor: must be a number from 0 to 1, got \"nan\""},
       {"render small.json -t 1 --fps abc --out x.png", "--fps: must be a number from 1 to 240, got \"abc\""},
       {"render small.json -t 1 --pitch 90 --out x.png", "--pitch: must be a number from -85 to 85, got \"90\""},
-      {"render small.json -t 1 --distance -1 --out x.png", "--distance: must be a positive number, got -1"},
+      {"render small.json -t 1 --distance -1 --out x.png",
+       "--distance: must be a positive number of at most 1000 (m; no mobile is larger), got -1"},
       {"simulate small.json -t 1 --wind 1 --wind-gust-time -0.5", "--wind-gust-time: must be a number >= 0, got -0.5"},
       {"simulate small.json -t 1 --wind 1 --wind-gust-time s", "--wind-gust-time: must be a number, got \"s\""},
+      // The mobile file's size rule (spec.hpp: kLongestLength) for the flags' lengths and points: an l0
+      // of 1e300 m made alpha infinite and the wind silently blew nothing.
+      {"simulate small.json -t 1 --wind 1 --wind-l0 1e300",
+       "--wind-l0: must be a positive number of at most 1000 (m; no mobile is larger), got 1e300"},
+      {"simulate small.json -t 1 --wind 1 --wind-r0 2000", "--wind-r0: must be a positive number of at most 1000"},
+      {"simulate small.json -t 1 --wind 1 --wind-from 0,0,1e300",
+       "--wind-from: must be a point x,y,z with each coordinate from -1000 to 1000 m (no mobile is larger), "
+       "got \"0,0,1e300\""},
+      {"render small.json -t 1 --distance 1e300 --out x.png", "--distance: must be a positive number of at most 1000"},
+      // A NaN or far-away camera drew an empty image without a word.
+      {"render small.json -t 1 --target nan 0 0 --out x.png", "--target: must be a number from -1000 to 1000, got \"nan\""},
+      {"render small.json -t 1 --yaw nan --out x.png", "--yaw: must be a finite number, got nan"},
+      // alpha up to water's density times l0^4 (spec.hpp: kDensestWind): 1000 * 0.5^4 = 62.5 kg m.
+      {"simulate small.json -t 1 --wind 1 --wind-l0 0.5 --wind-alpha 100",
+       "--wind-alpha: must be a positive number of at most 62.5 kg m: alpha = rho l0^4, and with l0 = 0.5 m that "
+       "is water's density, 1000 kg/m^3 (air's alpha is 0.07525 kg m), got 100"},
   };
   for (const auto& [args, message] : cases) {
     const Result r = aloft(args);

@@ -921,7 +921,13 @@ TEST(ParseScene, BadWindSourcesAndCamerasNameFilePathAndLine) {
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"beta\": 11}]", "wind_sources[0].beta", "\"beta\"",
        "must be a number from 0 to 10, got 11"},
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"alpha\": 0}]", "wind_sources[0].alpha", "\"alpha\"",
-       "must be a positive number (kg m)"},
+       "must be a positive number of at most 1000 kg m: alpha = rho l0^4, and with l0 = 1 m that is water's density, "
+       "1000 kg/m^3 (air's alpha is 1.204 kg m), got 0"},
+      // Denser than water (kDensestWind) for the source's own l0: 1000 * 0.5^4 = 62.5 kg m.
+      {"  \"wind_sources\": [\n    {" + fan + ", \"l0\": 0.5,\n     \"alpha\": 63}]", "wind_sources[0].alpha",
+       "\"alpha\"", "must be a positive number of at most 62.5 kg m: alpha = rho l0^4, and with l0 = 0.5 m"},
+      {"  \"wind_sources\": [\n    {" + fan + ",\n     \"alpha\": 1e300}]", "wind_sources[0].alpha", "\"alpha\"",
+       "got 1e+300"},
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"seed\": -1}]", "wind_sources[0].seed", "\"seed\"",
        "must be a whole number from 0 to 2^63 - 1, got -1"},
       {"  \"wind_sources\": [\n    {" + fan + ",\n     \"seed\": 1.5}]", "wind_sources[0].seed", "\"seed\"",
@@ -961,6 +967,10 @@ TEST(ParseScene, BadWindSourcesAndCamerasNameFilePathAndLine) {
     SCOPED_TRACE(text);
     expect_error(text, c.path, line_of(text, c.line_at), c.problem);
   }
+  // Water's alpha itself is taken (1000 * 0.5^4 = 62.5 kg m, exact in binary).
+  const MobileSpec water = parse_mobile_text(with_top_keys(
+      R"(  "wind_sources": [{"from": [1, 1, 0], "to": [0, 1, 0], "speed": 2, "l0": 0.5, "alpha": 62.5}])"));
+  EXPECT_EQ(water.wind_sources.at(0).alpha, 62.5);
 }
 
 }  // namespace

@@ -193,5 +193,20 @@ TEST(FileWindCli, FlagsWindAndFileSourcesBlowTogether) {
   EXPECT_NE(r.output.find("occlusion         6 refreshes"), std::string::npos) << r.output;
 }
 
+// --wind-alpha also sets the alpha of file sources that give none, so it is checked against each one's
+// l0: the fan room's fan has l0 = 1.2 m, so water's alpha 1000 * 1.2^4 = 2073.6 kg m. (With no --wind
+// there is no wind of the flags' own to check it against --wind-l0 for.)
+TEST(FileWindCli, FlagAlphaIsCheckedAgainstEachFileSourcesL0) {
+  const Result r = aloft("simulate " + fan_room + " -t 0.05 --wind-alpha 3000");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("fan-room.json: wind_sources[0] (l0 = 1.2 m) takes --wind-alpha, which must be a positive "
+                          "number of at most 2073.6 kg m"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("got 3000"), std::string::npos) << r.output;
+  // Within the rule it runs (water's alpha for l0 = 1.2 m).
+  EXPECT_EQ(aloft("simulate " + fan_room + " -t 0.05 --wind-alpha 2000").code, 0);
+}
+
 }  // namespace
 }  // namespace aloft::test

@@ -26,22 +26,24 @@ struct CameraFlags {
   void add_to(CLI::App* sub) {
     sub->add_option("--yaw", yaw_deg, "Camera turn about the vertical (degrees; 0 faces the wall)")
         ->type_name("DEG")
+        ->check(cli::finite_number())
         ->group("Camera");
     sub->add_option("--pitch", pitch_deg, "Camera height angle above the horizontal (degrees, -85..85)")
         ->type_name("DEG")
         ->check(cli::number_in(-85.0, 85.0))
         ->group("Camera");
-    sub->add_option("--distance", distance, "Camera distance from its target (m, > 0)")
+    sub->add_option("--distance", distance, "Camera distance from its target (m, > 0, up to 1000)")
         ->type_name("M")
-        ->check(cli::positive_number())
+        ->check(cli::length_in_metres())
         ->group("Camera");
     sub->add_option("--fov", fov_deg, "Vertical field of view (degrees, 5..120)")
         ->type_name("DEG")
         ->check(cli::number_in(5.0, 120.0))
         ->group("Camera");
-    sub->add_option("--target", target, "Point the camera looks at: X Y Z (m, world)")
+    sub->add_option("--target", target, "Point the camera looks at: X Y Z (m, world, each -1000 to 1000)")
         ->type_name("X Y Z")
         ->expected(3)
+        ->check(cli::number_in(-kLongestLength, kLongestLength))
         ->group("Camera");
   }
 
