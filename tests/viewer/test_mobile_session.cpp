@@ -84,6 +84,33 @@ TEST_F(Session, BrokenReloadKeepsTheOldMobileRunningAndFixedReloadReplacesIt) {
   EXPECT_EQ(session.simulation().state().time, 0.0);
 }
 
+// The panel's settings keep the mobile file's rules (the panel's sliders clamp too, but a value typed
+// into one used to pass unclamped): out of range, the session refuses with a message and keeps what runs.
+TEST_F(Session, SettingsFromTheWindowKeepTheFilesRules) {
+  MobileSession session(fish_.string());
+  const int generation = session.model_generation();
+  const std::pair<BuildSettings, const char*> refused[] = {
+      {BuildSettings{{}, 1e300, {}, {}, {}}, "the total mass must be a number from 1e-06 to 1e+06 (kg)"},
+      {BuildSettings{{}, {}, 5.0, {}, {}}, "the restitution must be a number from 0 to 1"},
+      {BuildSettings{{}, {}, {}, -1.0, {}}, "the friction coefficient must be a number >= 0"},
+  };
+  for (const auto& [build, message] : refused) {
+    EXPECT_FALSE(session.rebuild(build)) << message;
+    EXPECT_EQ(session.error(), message);
+    EXPECT_EQ(session.model_generation(), generation) << "the old model must stay";
+  }
+  const DampingSpec damping = session.damping();
+  EXPECT_FALSE(session.set_damping(DampingSpec{1e300, 0.1}));
+  EXPECT_EQ(session.error(), "the damping rates must be a number from 0 to 100 (1/s)");
+  EXPECT_EQ(session.damping().linear, damping.linear);
+  // Within the rules both are taken, and the error goes.
+  EXPECT_TRUE(session.set_damping(DampingSpec{0.5, 0.5}));
+  EXPECT_EQ(session.damping().linear, 0.5);
+  EXPECT_TRUE(session.rebuild(BuildSettings{{}, {}, 0.5, {}, {}}));
+  EXPECT_EQ(session.error(), "");
+  EXPECT_EQ(session.model().restitution.at(1), 0.5);
+}
+
 TEST_F(Session, ErrorsNameTheFileAndPlace) {
   MobileSession session(fish_.string());
   // A negative radius: a meaning error with a JSON path and a line.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <stdexcept>
 
@@ -37,18 +38,35 @@ bool same_pose(const Model& a, const Model& b) {
 
 double moving_mass(const Model& m) { return std::accumulate(m.mass.begin() + 1, m.mass.end(), 0.0); }
 
+// "<what> must be a number from <lo> to <hi> (<unit>)", the unit left out when empty.
+std::string range_text(const char* what, double lo, double hi, const char* unit) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%s must be a number from %g to %g%s%s%s", what, lo, hi, *unit ? " (" : "", unit,
+                *unit ? ")" : "");
+  return text;
+}
+
 }  // namespace
 
 std::unique_ptr<Model> compile_with(const MobileSpec& spec_in, const BuildSettings& build) {
   MobileSpec spec = spec_in;
   if (build.balance) spec.balance.mode = *build.balance;
+  // The mobile file's rules (parse_mobile.cpp, spec.hpp), for settings that come from the window instead.
   if (build.total_mass) {
-    if (!(*build.total_mass > 0) || !std::isfinite(*build.total_mass))
-      throw std::invalid_argument("the total mass must be a positive number of kg");
+    if (!(*build.total_mass >= kLightestMobile && *build.total_mass <= kHeaviestMobile))
+      throw std::invalid_argument(range_text("the total mass", kLightestMobile, kHeaviestMobile, "kg"));
     spec.balance.total_mass = *build.total_mass;
   }
-  if (build.restitution) spec.contact.restitution = *build.restitution;
-  if (build.friction) spec.contact.friction = *build.friction;
+  if (build.restitution) {
+    if (!(*build.restitution >= 0 && *build.restitution <= 1))
+      throw std::invalid_argument(range_text("the restitution", 0, 1, ""));
+    spec.contact.restitution = *build.restitution;
+  }
+  if (build.friction) {
+    if (!(std::isfinite(*build.friction) && *build.friction >= 0))
+      throw std::invalid_argument("the friction coefficient must be a number >= 0");
+    spec.contact.friction = *build.friction;
+  }
   if (build.contact_enabled) spec.contact.enabled = *build.contact_enabled;
   if (spec.balance.mode == BalanceMode::Mass && !spec.balance.total_mass) {
     // A file in another mode switched to "mass" in the window: keep the mass it has now.
@@ -155,9 +173,15 @@ bool MobileSession::rebuild(const BuildSettings& build) {
   }
 }
 
-void MobileSession::set_damping(const DampingSpec& damping) {
+bool MobileSession::set_damping(const DampingSpec& damping) {
+  const auto in_range = [](double rate) { return rate >= 0 && rate <= kGreatestDampingRate; };  // NaN fails
+  if (!in_range(damping.linear) || !in_range(damping.angular)) {
+    error_ = range_text("the damping rates", 0, kGreatestDampingRate, "1/s");
+    return false;
+  }
   damping_ = damping;
   sim_->set_damping(damping);
+  return true;
 }
 
 void MobileSession::reset() {

@@ -94,7 +94,9 @@ class MobileSession {
   // otherwise the mobile restarts from rest. On a compile error the old model stays, error() says why.
   bool rebuild(const BuildSettings& build);
   const BuildSettings& build_settings() const { return build_; }
-  void set_damping(const DampingSpec& damping);
+  // Rates out of the mobile file's range (0 to kGreatestDampingRate, 1/s) are refused: false, error() says
+  // why, the old damping stays.
+  bool set_damping(const DampingSpec& damping);
   const DampingSpec& damping() const { return damping_; }
 
   void reset();                 // to the designed pose at rest

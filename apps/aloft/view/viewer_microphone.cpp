@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bounded_slider.hpp"
 #include "viewer_state.hpp"
 
 #if ALOFT_HAVE_MICROPHONE
@@ -58,7 +59,7 @@ void ViewerState::draw_microphone_controls() {
   if (ImGui::Button("Calibrate")) mic.recalibrate();
   ImGui::SameLine();
   ImGui::SetNextItemWidth(150);
-  if (ImGui::SliderFloat("gain", &mic_gain, 1.0f, 200.0f, "%.0f m/s", ImGuiSliderFlags_Logarithmic))
+  if (bounded_slider("gain", mic_gain, 1.0f, 200.0f, "%.0f m/s", ImGuiSliderFlags_Logarithmic))
     mic.set_gain(mic_gain);
 #else
   ImGui::TextDisabled("no microphone support in this build");

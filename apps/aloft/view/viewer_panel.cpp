@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "bounded_slider.hpp"
 #include "viewer_state.hpp"
 
 namespace aloft::view {
@@ -225,7 +226,7 @@ void ViewerState::draw_panel() {
   ImGui::TextDisabled("(?) keys");
   if (ImGui::IsItemClicked()) show_help = true;
   float scale = static_cast<float>(session->time_scale);
-  if (ImGui::SliderFloat("time scale", &scale, 1.0f / 64, 4.0f, "x%.3g", ImGuiSliderFlags_Logarithmic))
+  if (bounded_slider("time scale", scale, 1.0f / 64, 4.0f, "x%.3g", ImGuiSliderFlags_Logarithmic))
     session->time_scale = scale;
 
   if (ImGui::CollapsingHeader("Mobile")) {
@@ -241,20 +242,20 @@ void ViewerState::draw_panel() {
     }
     float mass = static_cast<float>(model.balance.total_mass);
     ImGui::BeginDisabled(mode != BalanceMode::Mass);
-    ImGui::SliderFloat("total mass (kg)", &mass, 0.05f, 50.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
+    bounded_slider("total mass (kg)", mass, 0.05f, 50.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
     if (ImGui::IsItemDeactivatedAfterEdit()) {
       build.total_mass = mass;
       session->rebuild(build);
     }
     ImGui::EndDisabled();
     float restitution = static_cast<float>(build.restitution.value_or(session->spec().contact.restitution));
-    ImGui::SliderFloat("restitution", &restitution, 0.0f, 1.0f, "%.2f");
+    bounded_slider("restitution", restitution, 0.0f, 1.0f, "%.2f");
     if (ImGui::IsItemDeactivatedAfterEdit()) {
       build.restitution = restitution;
       session->rebuild(build);
     }
     float friction = static_cast<float>(build.friction.value_or(session->spec().contact.friction));
-    ImGui::SliderFloat("friction", &friction, 0.0f, 2.0f, "%.2f");
+    bounded_slider("friction", friction, 0.0f, 2.0f, "%.2f");
     if (ImGui::IsItemDeactivatedAfterEdit()) {
       build.friction = friction;
       session->rebuild(build);
@@ -266,8 +267,8 @@ void ViewerState::draw_panel() {
     }
     DampingSpec damping = session->damping();
     float linear = static_cast<float>(damping.linear), angular = static_cast<float>(damping.angular);
-    bool changed = ImGui::SliderFloat("air damping (1/s)", &linear, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
-    changed |= ImGui::SliderFloat("spin damping (1/s)", &angular, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    bool changed = bounded_slider("air damping (1/s)", linear, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    changed |= bounded_slider("spin damping (1/s)", angular, 0.0f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
     if (changed) session->set_damping(DampingSpec{linear, angular});
   }
 
@@ -282,20 +283,20 @@ void ViewerState::draw_panel() {
     if (ImGui::Button("From me")) w.follow_camera = true;
     ImGui::EndDisabled();
     float breeze = static_cast<float>(w.breeze);
-    if (ImGui::SliderFloat("breeze v0 (m/s)", &breeze, 0.0f, 10.0f, "%.2f")) w.breeze = breeze;
+    if (bounded_slider("breeze v0 (m/s)", breeze, 0.0f, 10.0f, "%.2f")) w.breeze = breeze;
     const double v0 = session->v0();
     ImGui::ProgressBar(static_cast<float>(std::min(v0 / 10, 1.0)), ImVec2(-1, 0),
                        (std::to_string(static_cast<int>(std::lround(v0 * 100)) / 100.0).substr(0, 4) + " m/s at S0").c_str());
     float r0 = static_cast<float>(w.r0), l0 = static_cast<float>(w.l0);
-    if (ImGui::SliderFloat("r0 (m)", &r0, 0.05f, 3.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.r0 = r0;
-    if (ImGui::SliderFloat("l0 (m)", &l0, 0.1f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.l0 = l0;
+    if (bounded_slider("r0 (m)", r0, 0.05f, 3.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.r0 = r0;
+    if (bounded_slider("l0 (m)", l0, 0.1f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.l0 = l0;
     float alpha = static_cast<float>(session->wind() ? session->wind()->alpha() : kAirDensity * std::pow(w.l0, 4));
-    if (ImGui::SliderFloat("alpha (kg m)", &alpha, 0.01f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic))
+    if (bounded_slider("alpha (kg m)", alpha, 0.01f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic))
       w.settings.alpha = alpha;
     ImGui::SameLine();
     if (ImGui::SmallButton("air")) w.settings.alpha = -1;
     float beta = static_cast<float>(w.settings.beta);
-    if (ImGui::SliderFloat("beta (turbulence)", &beta, 0.0f, 2.0f, "%.2f")) w.settings.beta = beta;
+    if (bounded_slider("beta (turbulence)", beta, 0.0f, 2.0f, "%.2f")) w.settings.beta = beta;
     ImGui::Checkbox("cone (K)", &show_cone);
     ImGui::SameLine();
     ImGui::Checkbox("what it reaches (O)", &show_occlusion);
