@@ -43,9 +43,17 @@ CLI::Validator point_validator() {
       "");
 }
 
-// --wind-alpha against --wind-l0 for the flags' own wind (the rule needs both, so it is checked once the
-// command line is read). Without one, --wind-alpha is only for the file's sources: make_file_wind checks it.
-void check_alpha_against_l0(const WindOptions& o) {
+// What needs more than one flag, checked once the command line is read:
+// - the flags that place the flags' own wind, which without --wind, --wind-speed or --wind-audio would be
+//   ignored without a word (the file's sources have their own from, to, r0 and l0);
+// - --wind-alpha against --wind-l0 for that wind. Without one, --wind-alpha is only for the file's
+//   sources, and make_file_wind checks it against theirs.
+void check_wind_flags(const CLI::App& sub, const WindOptions& o) {
+  if (!o.any())
+    for (const char* name : {"--wind-from", "--wind-to", "--wind-r0", "--wind-l0"})
+      if (sub.count(name) > 0)
+        throw CLI::ValidationError(name, "places the wind of --wind, --wind-speed or --wind-audio, and none of them "
+                                         "was given (a mobile file's wind sources have their own)");
   if (o.any() && o.alpha > 0 && !acceptable_wind_alpha(o.alpha, o.l0))
     throw CLI::ValidationError("--wind-alpha", wind_alpha_rule(o.l0) + ", got " + format("%g", o.alpha));
 }
@@ -134,7 +142,6 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
       ->type_name("A")
       ->check(positive_number())
       ->group(group);
-  sub->parse_complete_callback([&o] { check_alpha_against_l0(o); });
   sub->add_option("--wind-beta", o.beta, "Turbulence: |F_random| < beta |F_stoke| (0: none, up to 10)")
       ->type_name("B")
       ->capture_default_str()
@@ -169,19 +176,23 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
       ->type_name("G")
       ->capture_default_str()
       ->check(non_negative_number())
+      ->needs("--wind-audio")  // else ignored without a word
       ->group(group);
   sub->add_option("--wind-noise-floor", o.noise_floor,
                   "With --wind-audio: the noise floor (RMS, 0 to 1) instead of calibrating it")
       ->type_name("RMS")
       ->check(number_in(0.0, 1.0))
+      ->needs("--wind-audio")  // else ignored without a word
       ->group(group);
   sub->add_option("--wind-calibrate", o.calibrate,
                   "With --wind-audio: seconds of room sound at the start that set the noise floor (0 to 60)")
       ->type_name("S")
       ->capture_default_str()
       ->check(number_in(0.0, 60.0))
+      ->needs("--wind-audio")  // else ignored without a word
       ->group(group);
   add_no_file_wind_flag(sub, o.no_file_wind);
+  sub->parse_complete_callback([sub, &o] { check_wind_flags(*sub, o); });
 }
 
 void add_no_file_wind_flag(CLI::App* sub, bool& no_file_wind) {

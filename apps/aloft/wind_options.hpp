@@ -36,8 +36,9 @@ struct WindOptions {
   bool any() const { return constant || !speed_csv.empty() || !audio.empty(); }
 };
 
-// Adds the wind flags to `sub`, and the check of --wind-alpha against --wind-l0 as `sub`'s
-// parse_complete_callback (CLI11 keeps one; `sub` must not set its own).
+// Adds the wind flags to `sub`, and the checks that need several of them (--wind-alpha against --wind-l0;
+// no source placed without a wind) as `sub`'s parse_complete_callback (CLI11 keeps one; `sub` must not
+// set its own).
 void add_wind_options(CLI::App* sub, WindOptions& o);
 // A steady wind speed v0 (m/s) the cone model takes (aloft/spec.hpp: kFastestWind), as --wind checks it.
 CLI::Validator wind_speed();

@@ -74,6 +74,16 @@ TEST(WindCli, BadFlagsAreUsageErrors) {
   r = aloft("simulate " + fish + " -t 0.2 --wind 1 --wind-from 0,2,0 --wind-to 0,2,0");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("two different points"), std::string::npos) << r.output;
+  // Flags that shape a wind that was not asked for are refused, not ignored without a word.
+  r = aloft("simulate " + fish + " -t 0.2 --wind-from 1,2,3");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--wind-from: places the wind of --wind, --wind-speed or --wind-audio, and none of them "
+                          "was given"),
+            std::string::npos)
+      << r.output;
+  r = aloft("simulate " + fish + " -t 0.2 --wind 1 --wind-gain 50");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--wind-gain requires --wind-audio"), std::string::npos) << r.output;
 }
 
 }  // namespace
