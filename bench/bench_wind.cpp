@@ -13,18 +13,13 @@
 namespace aloft::bench {
 namespace {
 
-// The command line's default source: S0 1.5 m in front (+z) of the mobile, blowing along -z, l0 = 1 m.
-WindSource front_source(const Model& model, const State& state) {
-  return source_facing_mobile(model, state, Vec3(0, 0, -1), 1.5, 1.0);
-}
-
 void BM_WindOcclusion(benchmark::State& st) {
   if (!preset_exists("steel-fish")) return st.SkipWithError("mobiles/steel-fish.json not found");
   const auto model = preset_model("steel-fish");
   const State state = swinging_state(*model);  // a generic pose, not the symmetric drawing
   WindSettings settings;
   settings.resolution = static_cast<int>(st.range(0));
-  Wind wind(*model, front_source(*model, state), settings);
+  Wind wind(*model, source_in_front(*model, state), settings);
   for (auto _ : st) {
     wind.refresh_occlusion(state);
     benchmark::DoNotOptimize(wind.elements().data());
@@ -40,7 +35,7 @@ void BM_WindApply(benchmark::State& st) {
   if (!preset_exists("steel-fish")) return st.SkipWithError("mobiles/steel-fish.json not found");
   const auto model = preset_model("steel-fish");
   const State state = swinging_state(*model);
-  Wind wind(*model, front_source(*model, state), WindSettings{});
+  Wind wind(*model, source_in_front(*model, state), WindSettings{});
   wind.refresh_occlusion(state);
   ExternalLoads loads;
   loads.resize(model->count);
@@ -58,7 +53,7 @@ void BM_SteelFishInWind(benchmark::State& st) {
   if (!preset_exists("steel-fish")) return st.SkipWithError("mobiles/steel-fish.json not found");
   const auto model = preset_model("steel-fish");
   Simulation sim(*model);
-  Wind wind(*model, front_source(*model, sim.state()), WindSettings{});
+  Wind wind(*model, source_in_front(*model, sim.state()), WindSettings{});
   const int refresh_every = 17;  // 1 ms steps: 58.8 refreshes per simulated second (the CLI's --wind-refresh 60)
   long long step = 0;
   for (auto _ : st) {

@@ -119,7 +119,8 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
   constant->excludes(speed)->excludes(audio);
   speed->excludes(audio);
   sub->add_option("--wind-from", o.from,
-                  "Centre of the source disc S0 (x,y,z, m); default: 1.5 m in front (+z) of the mobile's centre")
+                  format("Centre of the source disc S0 (x,y,z, m); default: %g m in front (+z) of the mobile's centre",
+                         kFrontSourceDistance))
       ->type_name("X,Y,Z")
       ->check(point_validator())
       ->group(group);
@@ -208,7 +209,7 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
   // unless r0 is given.
   const MobileSphere cover = mobile_sphere(model, state);
   const Vec3 to = o.to.empty() ? cover.center : *read_point(o.to);
-  const Vec3 from = o.from.empty() ? Vec3(cover.center + Vec3(0, 0, 1.5)) : *read_point(o.from);
+  const Vec3 from = o.from.empty() ? Vec3(cover.center + Vec3(0, 0, kFrontSourceDistance)) : *read_point(o.from);
   if ((to - from).norm() < 1e-9) throw Failure("--wind-from and --wind-to must be two different points");
   const WindSettings settings = settings_from_flags(o);
   try {

@@ -21,7 +21,7 @@ struct WindOptions {
   std::string audio;                   // --wind-audio FILE
   std::string from, to;                // --wind-from, --wind-to "x,y,z" (m, world)
   double r0 = 0;                       // m; 0: wide enough to cover the mobile
-  double l0 = 1.0;                     // m
+  double l0 = kDefaultL0;              // m
   double alpha = -1;                   // kg m; < 0: kAirDensity * l0^4
   double beta = 0.3;
   double gust_time = 0.4;              // s

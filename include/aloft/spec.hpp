@@ -124,6 +124,10 @@ inline constexpr double kFastestWind = 100.0;
 bool acceptable_wind_speed(double v0);
 std::string wind_speed_rule();
 
+// The distance from a wind cone's vertex to its disc S0 unless told (m): WindSource's, a file source's
+// and the command line's (--wind-l0).
+inline constexpr double kDefaultL0 = 1.0;
+
 // Density of air at 20 C, sea level (kg/m^3): a wind's default alpha is kAirDensity * l0^4 (wind.hpp).
 inline constexpr double kAirDensity = 1.204;
 
@@ -147,7 +151,7 @@ struct WindSourceSpec {
   Vec3 from = Vec3::Zero();                 // centre of S0, world, m
   Vec3 to = Vec3::Zero();                   // a point on its axis that it blows towards, world, m (!= from)
   double r0 = 0.25;                         // radius of S0, m (> 0)
-  double l0 = 1.0;                          // vertex to S0, m (> 0)
+  double l0 = kDefaultL0;                   // vertex to S0, m (> 0)
   double speed = 0;                         // v0 at S0 at full strength, m/s (0 to kFastestWind)
   WindProfileSpec profile;
   // Per-source overrides of the wind's settings (WindSettings); empty: the run's value.

@@ -47,7 +47,7 @@ struct WindSource {
   Vec3 vertex = Vec3(0, 1.8, 3.0);     // cone vertex, world, m
   Vec3 direction = Vec3(0, 0, -1);     // unit, world: where the wind blows
   double r0 = 0.25;                    // radius of S0, m (> 0)
-  double l0 = 1.0;                     // distance from the vertex to S0, m (> 0)
+  double l0 = kDefaultL0;              // distance from the vertex to S0, m (> 0)
 
   // A source whose disc S0 is centred at `from` and blows towards `to` (vertex l0 behind `from`).
   static WindSource aimed(const Vec3& from, const Vec3& to, double r0, double l0);
@@ -84,6 +84,12 @@ WindSource source_covering(const Vec3& from, const Vec3& to, double l0, const Mo
 // view direction; the command line's default is along -z (from the front).
 WindSource source_facing_mobile(const Model& model, const State& state, const Vec3& along, double distance,
                                 double l0);
+
+// The command line's wind unless told otherwise, and the one the benchmarks and tests blow: S0
+// kFrontSourceDistance in front (+z) of the mobile's centre, blowing along -z
+// (source_facing_mobile(model, state, -z, kFrontSourceDistance, l0)).
+inline constexpr double kFrontSourceDistance = 1.5;  // m
+WindSource source_in_front(const Model& model, const State& state, double l0 = kDefaultL0);
 
 struct WindSettings {
   double alpha = -1;          // drag constant of eq. 4, kg m; < 0: kAirDensity * l0^4 (physical, docs/wind.md)

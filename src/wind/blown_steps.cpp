@@ -13,8 +13,7 @@ BlownSteps::BlownSteps(const Model& model, Simulation& sim, double v0) : sim_(si
   if (v0 == 0) return;
   if (!acceptable_wind_speed(v0)) throw std::invalid_argument(wind_speed_rule() + ", got " + std::to_string(v0));
   v0_ = v0;
-  wind_ = std::make_unique<Wind>(model, source_facing_mobile(model, sim.state(), Vec3(0, 0, -1), 1.5, 1.0),
-                                 WindSettings{});
+  wind_ = std::make_unique<Wind>(model, source_in_front(model, sim.state()), WindSettings{});
   refresh_every_ = occlusion_refresh_steps(kOcclusionRefreshRate, sim.timestep());
   timer_ = std::make_unique<ApartTimer>();
 }

@@ -98,4 +98,8 @@ WindSource source_facing_mobile(const Model& model, const State& state, const Ve
   return source_covering(cover.center - distance * along.normalized(), cover.center, l0, cover);
 }
 
+WindSource source_in_front(const Model& model, const State& state, double l0) {
+  return source_facing_mobile(model, state, Vec3(0, 0, -1), kFrontSourceDistance, l0);
+}
+
 }  // namespace aloft

@@ -24,7 +24,7 @@ struct Outcome {
 Outcome breathe(double v0, double seconds, double beta) {
   static const Model model = load_preset("steel-fish", BalanceMode::Mass, /*damping=*/true);
   Simulation sim(model);
-  const WindSource source = source_facing_mobile(model, sim.state(), Vec3(0, 0, -1), 1.5, 1.0);
+  const WindSource source = source_in_front(model, sim.state());
   WindSettings settings;
   settings.beta = beta;
   Wind wind(model, source, settings);

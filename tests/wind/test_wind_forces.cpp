@@ -188,7 +188,8 @@ TEST(WindSource, AimedPutsS0AtFromAndValidates) {
 }
 
 // The sources sized to the mobile: the Steel Fish's every shape corner lies in mobile_sphere, and the
-// cone of source_facing_mobile (and of source_covering, off to one side) holds that whole sphere.
+// cone of source_in_front (source_facing_mobile's, from the front) and of source_covering (off to one
+// side) holds that whole sphere.
 TEST(WindSource, SourcesFacingTheMobileCoverItsWholeSphere) {
   const Model model = load_mobile(preset_path("steel-fish"));
   const State state = rest_state(model);
@@ -207,9 +208,9 @@ TEST(WindSource, SourcesFacingTheMobileCoverItsWholeSphere) {
     const double off_axis = std::acos(std::clamp(to_center.normalized().dot(s.direction), -1.0, 1.0));
     return off_axis + std::asin(cover.radius / to_center.norm()) <= s.half_angle() + 1e-12;
   };
-  const WindSource facing = source_facing_mobile(model, state, Vec3(0, 0, -1), 1.5, 1.0);
+  const WindSource facing = source_in_front(model, state);
   EXPECT_TRUE(holds_sphere(facing));
-  EXPECT_NEAR((facing.disc_center() - (cover.center + Vec3(0, 0, 1.5))).norm(), 0, 1e-12);
+  EXPECT_NEAR((facing.disc_center() - (cover.center + Vec3(0, 0, kFrontSourceDistance))).norm(), 0, 1e-12);
   // Aimed at the centre from elsewhere: S0 where asked, the cone still holding the sphere, and no wider
   // than it needs (the sphere touches the cone: 1e-9 of its half angle).
   const Vec3 from = cover.center + Vec3(1, 0.5, 2);
