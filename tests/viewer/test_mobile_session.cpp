@@ -109,6 +109,16 @@ TEST_F(Session, SettingsFromTheWindowKeepTheFilesRules) {
   EXPECT_TRUE(session.rebuild(BuildSettings{{}, {}, 0.5, {}, {}}));
   EXPECT_EQ(session.error(), "");
   EXPECT_EQ(session.model().restitution.at(1), 0.5);
+#if ALOFT_HAVE_WIND
+  // A set alpha follows a shorter l0 down to water's (kDensestWind l0^4 = 1000 * 0.5^4 = 62.5 kg m, exact).
+  session.wind_control.settings.alpha = 500;
+  session.wind_control.l0 = 0.5;
+  ASSERT_TRUE(session.update_wind(Vec3(0, 0, -1))) << session.error();
+  EXPECT_EQ(session.wind()->alpha(), 62.5);
+  session.wind_control.settings.alpha = 10;  // within the rule: kept
+  ASSERT_TRUE(session.update_wind(Vec3(0, 0, -1))) << session.error();
+  EXPECT_EQ(session.wind()->alpha(), 10);
+#endif
 }
 
 TEST_F(Session, ErrorsNameTheFileAndPlace) {

@@ -226,6 +226,9 @@ bool MobileSession::update_wind(const Vec3& camera_forward) {
     Vec3 along(camera_forward.x(), 0, camera_forward.z());
     if (along.norm() > 1e-6) w.along = along.normalized();
   }
+  // A set alpha keeps the files' rule at this l0 (at most water's, kDensestWind l0^4): a shorter l0
+  // takes it down with it.
+  w.settings.alpha = std::min(w.settings.alpha, kDensestWind * std::pow(w.l0, 4));
   try {
     WindSource source = source_facing_mobile(*model_, sim_->state(), w.along, w.distance, w.l0);
     if (w.r0 > 0) source.r0 = w.r0;

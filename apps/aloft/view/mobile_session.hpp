@@ -137,8 +137,9 @@ class MobileSession {
   void gust() { gust_level_ = wind_control.gust_peak; }
   double v0() const;                                   // m/s now: breeze + gust + microphone
   const Wind* wind() const { return wind_.get(); }
-  // Apply wind_control's source and settings (after a slider moved). Returns false with error() set when
-  // they are invalid.
+  // Apply wind_control's source and settings (after a slider moved). A set alpha beyond water's for l0
+  // (kDensestWind l0^4, the files' rule) is brought down to it. Returns false with error() set when they
+  // are invalid.
   bool update_wind(const Vec3& camera_forward);
 
   // The file's wind sources, in file order (rebuilt with every new model; a source keeps its on/off

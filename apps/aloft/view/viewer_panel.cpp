@@ -290,8 +290,14 @@ void ViewerState::draw_panel() {
     float r0 = static_cast<float>(w.r0), l0 = static_cast<float>(w.l0);
     if (bounded_slider("r0 (m)", r0, 0.05f, 3.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.r0 = r0;
     if (bounded_slider("l0 (m)", l0, 0.1f, 5.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.l0 = l0;
-    float alpha = static_cast<float>(session->wind() ? session->wind()->alpha() : kAirDensity * std::pow(w.l0, 4));
-    if (bounded_slider("alpha (kg m)", alpha, 0.01f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic))
+    // alpha = rho l0^4 (docs/wind.md): from a hundredth of air's to water's (the files' rule, kDensestWind)
+    // at this l0, so that the slider means the same at every l0 (MobileSession::update_wind keeps a set
+    // alpha within water's when l0 shrinks).
+    const double l0_4 = std::pow(w.l0, 4);
+    const float alpha_lo = static_cast<float>(kAirDensity * l0_4 / 100);
+    const float alpha_hi = static_cast<float>(kDensestWind * l0_4);
+    float alpha = static_cast<float>(session->wind() ? session->wind()->alpha() : kAirDensity * l0_4);
+    if (bounded_slider("alpha (kg m)", alpha, alpha_lo, alpha_hi, "%.3g", ImGuiSliderFlags_Logarithmic))
       w.settings.alpha = alpha;
     ImGui::SameLine();
     if (ImGui::SmallButton("air")) w.settings.alpha = -1;
