@@ -65,10 +65,10 @@ Runner add_mic(CLI::App& app) {
       ->check(integer_in(8000, 192000));
   sub->add_option("--csv", o->csv, "Write v0 over audio time as \"t,v0\" rows (s, m/s), usable by --wind-speed")
       ->type_name("FILE");
-  sub->add_option("--interval", o->interval, "Audio time between CSV rows (s)")
+  sub->add_option("--interval", o->interval, "Audio time between CSV rows (s, at least one sample, up to 3600)")
       ->type_name("S")
       ->capture_default_str()
-      ->check(positive_number());
+      ->check(number_in(1.0 / 192000, kLongestSpeedInterval));  // one sample at the highest --rate
   sub->footer(
       "Stay quiet for the first --calibrate seconds (the room's noise floor is measured), then blow.\n"
       "v0 = gain * (envelope - noise floor): the envelope is the RMS over 5 ms, rising in 5 ms and falling\n"

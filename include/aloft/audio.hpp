@@ -95,7 +95,9 @@ SpeedSeries read_speed_csv(const std::string& path);
 
 // Feeds an EnvelopeFollower and records v0 every `interval` seconds of *audio* time (the follower's value
 // after the sample that ends each interval, sample index round(k interval rate)): the same series whether
-// the samples come from a file in one piece or from a device in chunks of any size.
+// the samples come from a file in one piece or from a device in chunks of any size. The interval is from
+// one sample (1 / rate) to kLongestSpeedInterval; the constructor throws std::invalid_argument otherwise.
+inline constexpr double kLongestSpeedInterval = 3600;  // s
 class SpeedSampler {
  public:
   SpeedSampler(int sample_rate, const EnvelopeSettings& settings, double interval = 0.001);

@@ -103,7 +103,11 @@ double EnvelopeFollower::v0() const {
 
 SpeedSampler::SpeedSampler(int sample_rate, const EnvelopeSettings& settings, double interval)
     : follower_(sample_rate, settings), rate_(sample_rate), interval_(interval) {
-  require(std::isfinite(interval) && interval > 0, "the speed series interval must be > 0 s");
+  // At least one sample, so that every interval ends at a later sample than the one before. With 1e-300 s
+  // each interval's end rounds to the sample push() is at, and its loop records it again without end.
+  require(std::isfinite(interval) && interval * sample_rate >= 1 && interval <= kLongestSpeedInterval,
+          "the speed series interval must be from one sample (1/" + std::to_string(sample_rate) + " s) to " +
+              std::to_string(static_cast<int>(kLongestSpeedInterval)) + " s");
   series_.t.push_back(0);
   series_.v0.push_back(0);
   next_end_ = static_cast<std::uint64_t>(std::llround(interval_ * rate_));

@@ -1,5 +1,6 @@
 // The envelope follower and v0: silence gives 0, a burst gives a clear v0 within 50 ms, the noise floor is
-// calibrated from the first second, and a speed CSV reads back with clear errors.
+// calibrated from the first second, the sampler's interval is at least a sample, and a speed CSV reads
+// back with clear errors.
 
 #include <gtest/gtest.h>
 
@@ -7,6 +8,8 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <stdexcept>
+#include <vector>
 
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
@@ -105,6 +108,23 @@ TEST(Envelope, GivenNoiseFloorSkipsCalibration) {
   // A 0.1-amplitude square wave: RMS 0.1 exactly; v0 = 10 * (0.1 - 0.05) = 0.5 m/s once settled.
   for (int i = 0; i < 48000; ++i) f.push(i % 2 ? 0.1f : -0.1f);
   EXPECT_NEAR(f.v0(), 0.5, 1e-6);  // squares added up afresh per window: rounding only
+}
+
+// The interval is at least one sample: with 1e-300 s each interval's end rounds to the sample push() is
+// at, and it records that sample again without end (read in the code). At one sample, every sample is a
+// row and the times increase.
+TEST(SpeedSampler, IntervalsRunFromOneSampleToAnHour) {
+  const EnvelopeSettings settings;
+  EXPECT_THROW(SpeedSampler(48000, settings, 1e-300), std::invalid_argument);
+  EXPECT_THROW(SpeedSampler(8000, settings, 1e-4), std::invalid_argument);  // 0.8 of a sample
+  EXPECT_THROW(SpeedSampler(48000, settings, 3601), std::invalid_argument);
+  SpeedSampler every_sample(48000, settings, 1.0 / 48000);
+  const std::vector<float> quiet(480, 0.0f);
+  every_sample.push(quiet.data(), quiet.size());
+  const SpeedSeries& s = every_sample.series();
+  ASSERT_EQ(s.t.size(), 481u);  // t = 0, then one row per sample
+  for (std::size_t i = 1; i < s.t.size(); ++i) EXPECT_GT(s.t[i], s.t[i - 1]) << i;
+  EXPECT_DOUBLE_EQ(s.t.back(), 0.01);
 }
 
 TEST(SpeedSeries, InterpolatesAndHoldsEnds) {
