@@ -43,7 +43,8 @@ std::vector<std::unique_ptr<aloft::Wind>> file_winds(const aloft::Model& model, 
     if (w.beta) settings.beta = *w.beta;
     if (w.seed) settings.seed = *w.seed;
     try {
-      winds.push_back(std::make_unique<aloft::Wind>(model, aloft::WindSource::aimed(w.from, w.to, w.r0, w.l0), settings));
+      const aloft::WindSource source = aloft::WindSource::aimed(w.from, w.to, w.r0, w.l0);
+      winds.push_back(std::make_unique<aloft::Wind>(model, source, settings));
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "%s: the reader took it, the wind refused it: %s\n", w.path.c_str(), e.what());
       std::abort();

@@ -128,18 +128,20 @@ void add_wind_options(CLI::App* sub, WindOptions& o) {
       ->type_name("X,Y,Z")
       ->check(point_validator())
       ->group(group);
-  sub->add_option("--wind-r0", o.r0, "Radius of S0 (m, > 0, up to 1000); default: the cone just covers the mobile")
+  sub->add_option("--wind-r0", o.r0,
+                  format("Radius of S0 (m, > 0, up to %g); default: the cone just covers the mobile", kLongestLength))
       ->type_name("R0")
       ->check(length_in_metres())
       ->group(group);
-  sub->add_option("--wind-l0", o.l0, "Distance from the cone's vertex to S0 (m, > 0, up to 1000)")
+  sub->add_option("--wind-l0", o.l0, format("Distance from the cone's vertex to S0 (m, > 0, up to %g)", kLongestLength))
       ->type_name("L0")
       ->capture_default_str()
       ->check(length_in_metres())
       ->group(group);
   sub->add_option("--wind-alpha", o.alpha,
-                  "Drag constant alpha of F = alpha A v0^2 / l1^4 cos (kg m, > 0, up to water's 1000 * l0^4); "
-                  "default: air, 1.204 * l0^4")
+                  format("Drag constant alpha of F = alpha A v0^2 / l1^4 cos (kg m, > 0, up to water's %g * l0^4); "
+                         "default: air, %g * l0^4",
+                         kDensestWind, kAirDensity))
       ->type_name("A")
       ->check(positive_number())
       ->group(group);

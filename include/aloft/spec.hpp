@@ -155,7 +155,7 @@ struct WindSourceSpec {
   double speed = 0;                         // v0 at S0 at full strength, m/s (0 to kFastestWind)
   WindProfileSpec profile;
   // Per-source overrides of the wind's settings (WindSettings); empty: the run's value.
-  std::optional<double> alpha;              // kg m (0 < alpha <= kDensestWind * l0^4); run default: air, kAirDensity * l0^4
+  std::optional<double> alpha;              // kg m, 0 < alpha <= kDensestWind l0^4; run default: kAirDensity l0^4
   std::optional<double> beta;               // turbulence bound, 0..10
   std::optional<std::uint64_t> seed;        // of the turbulence
   std::string path;                         // e.g. "wind_sources[0]"

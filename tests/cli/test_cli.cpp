@@ -303,7 +303,8 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
        "got \"0,0,1e300\""},
       {"render small.json -t 1 --distance 1e300 --out x.png", "--distance: must be a positive number of at most 1000"},
       // A NaN or far-away camera drew an empty image without a word.
-      {"render small.json -t 1 --target nan 0 0 --out x.png", "--target: must be a number from -1000 to 1000, got \"nan\""},
+      {"render small.json -t 1 --target nan 0 0 --out x.png",
+       "--target: must be a number from -1000 to 1000, got \"nan\""},
       {"render small.json -t 1 --yaw nan --out x.png", "--yaw: must be a finite number, got nan"},
       // alpha up to water's density times l0^4 (spec.hpp: kDensestWind): 1000 * 0.5^4 = 62.5 kg m.
       {"simulate small.json -t 1 --wind 1 --wind-l0 0.5 --wind-alpha 100",

@@ -32,7 +32,8 @@ struct CameraFlags {
         ->type_name("DEG")
         ->check(cli::number_in(-85.0, 85.0))
         ->group("Camera");
-    sub->add_option("--distance", distance, "Camera distance from its target (m, > 0, up to 1000)")
+    sub->add_option("--distance", distance,
+                    cli::format("Camera distance from its target (m, > 0, up to %g)", kLongestLength))
         ->type_name("M")
         ->check(cli::length_in_metres())
         ->group("Camera");
@@ -40,7 +41,9 @@ struct CameraFlags {
         ->type_name("DEG")
         ->check(cli::number_in(5.0, 120.0))
         ->group("Camera");
-    sub->add_option("--target", target, "Point the camera looks at: X Y Z (m, world, each -1000 to 1000)")
+    sub->add_option("--target", target,
+                    cli::format("Point the camera looks at: X Y Z (m, world, each -%g to %g)", kLongestLength,
+                                kLongestLength))
         ->type_name("X Y Z")
         ->expected(3)
         ->check(cli::number_in(-kLongestLength, kLongestLength))
