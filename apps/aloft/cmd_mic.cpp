@@ -45,9 +45,9 @@ Runner add_mic(CLI::App& app) {
   sub->add_option("-d,--device", o->device, "Capture device by name (see --list); default: the system's default")
       ->type_name("NAME");
   sub->add_flag("-l,--list", o->list, "List the capture devices and exit");
-  sub->add_option("-t,--duration", o->duration, "Stop after this much audio (s); default: until Ctrl-C")
+  sub->add_option("-t,--duration", o->duration, format("Stop after this much audio (s, up to %g); default: until Ctrl-C", kLongestDuration))
       ->type_name("T")
-      ->check(positive_number());
+      ->check(duration_in_seconds());
   sub->add_option("--gain", o->gain, "m/s of v0 per unit of RMS above the noise floor (0 to 1e6)")
       ->type_name("G")
       ->capture_default_str()

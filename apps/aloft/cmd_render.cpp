@@ -43,10 +43,10 @@ Runner add_render(CLI::App& app) {
                                       "a directory for PNG frames (ends with /)")
       ->type_name("PATH")
       ->required();
-  sub->add_option("-t,--duration", o->duration, "Simulated time (s, > 0)")
+  sub->add_option("-t,--duration", o->duration, format("Simulated time (s, > 0, up to %g)", kLongestDuration))
       ->type_name("T")
       ->capture_default_str()
-      ->check(positive_number());
+      ->check(duration_in_seconds());
   add_balance_option(sub, o->balance);
   sub->add_option("--width", o->width, "Image width (pixels)")->capture_default_str()->check(integer_in(16, 8192));
   sub->add_option("--height", o->height, "Image height (pixels)")->capture_default_str()->check(integer_in(16, 8192));

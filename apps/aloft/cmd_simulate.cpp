@@ -99,11 +99,13 @@ Runner add_simulate(CLI::App& app) {
       "Simulate a mobile without a window and write its trajectory");
   sub->add_option("file", o->file, "The mobile file (JSON)")->type_name("FILE")->required();
   add_balance_option(sub, o->balance);
-  sub->add_option("-t,--duration", o->duration, "Simulated time (s, > 0)")
+  sub->add_option("-t,--duration", o->duration, format("Simulated time (s, > 0, up to %g)", kLongestDuration))
       ->type_name("T")
       ->required()
-      ->check(positive_number());
-  sub->add_option("--dt", o->dt, "Time step (s, > 0 and <= 0.01); default: the mobile's \"timestep\" (0.001 unless set)")
+      ->check(duration_in_seconds());
+  sub->add_option("--dt", o->dt,
+                  format("Time step (s, %g to %g); default: the mobile's \"timestep\" (0.001 unless set)",
+                         kShortestTimestep, kLongestTimestep))
       ->type_name("H")
       ->check(timestep_range());
   sub->add_option("-k,--every", o->every, "Write a trajectory frame every K steps (>= 1)")

@@ -122,6 +122,12 @@ CLI::Validator length_in_metres() {
                                format("a positive number of at most %g (m; no mobile is larger)", kLongestLength));
 }
 
+CLI::Validator duration_in_seconds() {
+  return finite_number_between(0, false, kLongestDuration,
+                               format("a positive number of at most %g (s, %.1f days)", kLongestDuration,
+                                      kLongestDuration / 86400));
+}
+
 CLI::Validator number_in(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& input) -> std::string {
@@ -153,7 +159,8 @@ CLI::Validator timestep_range() {
         const std::optional<double> parsed = read_number(input);
         if (!parsed) return "must be a number of seconds, got \"" + input + "\"";
         const double v = *parsed;
-        if (!(v > 0 && v <= 0.01)) return "must be greater than 0 and at most 0.01 s, got " + input;
+        if (!(v >= kShortestTimestep && v <= kLongestTimestep))
+          return format("must be from %g to %g s, got ", kShortestTimestep, kLongestTimestep) + input;
         return {};
       },
       "");

@@ -84,13 +84,19 @@ std::string source_dir();
 // The whole of `input` read as a number (std::stod: "1e5", "inf" and "nan" included), or nothing.
 std::optional<double> read_number(const std::string& input);
 
+// The longest time a command runs the simulation or listens for (s): 11.6 days, 1e9 steps at 1 ms. The
+// steps and frames it makes are counted in 64-bit integers, which -t 1e300 overflowed: simulate ran one
+// step and render wrote one frame, both without a word.
+inline constexpr double kLongestDuration = 1e6;
+
 // Validators with clear messages ("must be ..., got \"X\""), in the words the option's help uses.
 CLI::Validator positive_number();          // > 0
 CLI::Validator non_negative_number();      // >= 0
 CLI::Validator finite_number();            // any number but inf and nan
 CLI::Validator length_in_metres();         // (0, kLongestLength]: the mobile file's rule for lengths (spec.hpp)
+CLI::Validator duration_in_seconds();      // (0, kLongestDuration]
 CLI::Validator number_in(double lo, double hi);  // a number in [lo, hi]
-CLI::Validator timestep_range();           // (0, 0.01]
+CLI::Validator timestep_range();           // [kShortestTimestep, kLongestTimestep] (spec.hpp)
 CLI::Validator integer_in(long long lo, long long hi);  // an integer in [lo, hi]
 
 }  // namespace aloft::cli

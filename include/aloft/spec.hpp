@@ -110,6 +110,12 @@ inline constexpr double kStrongestGravity = 100.0;
 //   while rate * h < 2, so this holds for every timestep a file may ask (h <= 0.01 s); air gives
 //   0.01-0.1 (1e300 went non-finite at step 2).
 inline constexpr double kGreatestDampingRate = 100.0;
+// - The fixed step (s), the file's "timestep" and the command line's --dt: from a microsecond, a
+//   thousandth of the default (the step-size rule divides a step up to 256 times where a piece needs it),
+//   so that the steps of the longest run are counted in 64 bits (1e-300 s made their count overflow), to
+//   0.01 s, where the explicit damping and the joints' drift correction still hold.
+inline constexpr double kShortestTimestep = 1e-6;
+inline constexpr double kLongestTimestep = 0.01;
 
 // The fastest wind v0 at S0 (m/s) that the mobile file, the command line and a speed series may ask for.
 // The cone's continuity (eq. 2) and drag (eqs. 3-4) treat the air as incompressible, which holds to a few

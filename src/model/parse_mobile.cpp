@@ -448,8 +448,9 @@ void Reader::mobile(const json& root) {
   if (const json* v = find(root, "contact")) contact(*v, join(top, "contact"));
   if (const json* v = find(root, "timestep")) {
     const double dt = v->is_number() ? v->get<double>() : 0;
-    if (!v->is_number() || !(dt > 0 && dt <= 0.01))
-      fail(join(top, "timestep"), "must be a number of seconds > 0 and <= 0.01, got " + describe(*v));
+    if (!v->is_number() || !(dt >= kShortestTimestep && dt <= kLongestTimestep))
+      fail(join(top, "timestep"), "must be a number of seconds from " + format_number(kShortestTimestep) + " to " +
+                                      format_number(kLongestTimestep) + ", got " + describe(*v));
     spec_.timestep = dt;
   }
   if (const json* v = find(root, "joint_tolerance"))

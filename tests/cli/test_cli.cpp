@@ -302,6 +302,11 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
        "--wind-from: must be a point x,y,z with each coordinate from -1000 to 1000 m (no mobile is larger), "
        "got \"0,0,1e300\""},
       {"render small.json -t 1 --distance 1e300 --out x.png", "--distance: must be a positive number of at most 1000"},
+      // Steps and frames are counted in 64 bits: -t 1e300 overflowed them, and simulate ran one step and
+      // render wrote one frame without a word; so did a step of 1e-300 s.
+      {"simulate small.json -t 1e300", "--duration: must be a positive number of at most 1e+06 (s, 11.6 days), got 1e300"},
+      {"render small.json -t 1e300 --out x.mp4", "--duration: must be a positive number of at most 1e+06"},
+      {"simulate small.json -t 1 --dt 1e-300", "--dt: must be from 1e-06 to 0.01 s, got 1e-300"},
       // A NaN or far-away camera drew an empty image without a word.
       {"render small.json -t 1 --target nan 0 0 --out x.png",
        "--target: must be a number from -1000 to 1000, got \"nan\""},

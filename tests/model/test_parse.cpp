@@ -315,7 +315,9 @@ TEST(Parse, NonPositiveSize) {
   expect_error(radius, "components[1].shapes[0].sphere.radius", line_of(radius, "-0.01"),
                "must be a positive number (m), got -0.01");
   const std::string dt = "{\"name\": \"x\",\n\"timestep\": 0.1, \"components\": []}";
-  expect_error(dt, "timestep", 2, "> 0 and <= 0.01");
+  expect_error(dt, "timestep", 2, "must be a number of seconds from 1e-06 to 0.01, got 0.1");
+  const std::string tiny_dt = "{\"name\": \"x\",\n\"timestep\": 1e-300, \"components\": []}";
+  expect_error(tiny_dt, "timestep", 2, "must be a number of seconds from 1e-06 to 0.01, got 1e-300");
   const std::string wire = with_shape(R"({"wire": {"from": [0, 1, 0],
           "to": [0, 1, 0], "radius": 0.001}})");
   expect_error(wire, "components[1].shapes[0].wire.to", line_of(wire, "\"to\""), "must differ from \"from\"");
