@@ -32,19 +32,16 @@ constexpr std::size_t kMostWinds = 3;
 constexpr int kRefreshSteps = 5;
 constexpr int kItemBufferPixels = 64;  // per side: coarse, to keep each run short; the arithmetic is the same
 
-// The file's wind sources as `aloft simulate` builds them (alpha, beta and seed from the file when given).
+// The file's wind sources as `aloft simulate` builds them (file_source_cone, file_source_settings).
 std::vector<std::unique_ptr<aloft::Wind>> file_winds(const aloft::Model& model, const aloft::MobileSpec& spec) {
   std::vector<std::unique_ptr<aloft::Wind>> winds;
   for (std::size_t i = 0; i < spec.wind_sources.size() && i < kMostWinds; ++i) {
     const aloft::WindSourceSpec& w = spec.wind_sources[i];
-    aloft::WindSettings settings;
-    settings.resolution = kItemBufferPixels;
-    if (w.alpha) settings.alpha = *w.alpha;
-    if (w.beta) settings.beta = *w.beta;
-    if (w.seed) settings.seed = *w.seed;
+    aloft::WindSettings coarse;
+    coarse.resolution = kItemBufferPixels;
     try {
-      const aloft::WindSource source = aloft::WindSource::aimed(w.from, w.to, w.r0, w.l0);
-      winds.push_back(std::make_unique<aloft::Wind>(model, source, settings));
+      const aloft::WindSettings settings = aloft::file_source_settings(w, i, coarse);
+      winds.push_back(std::make_unique<aloft::Wind>(model, aloft::file_source_cone(w), settings));
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "%s: the reader took it, the wind refused it: %s\n", w.path.c_str(), e.what());
       std::abort();

@@ -45,7 +45,8 @@ Runner add_mic(CLI::App& app) {
   sub->add_option("-d,--device", o->device, "Capture device by name (see --list); default: the system's default")
       ->type_name("NAME");
   sub->add_flag("-l,--list", o->list, "List the capture devices and exit");
-  sub->add_option("-t,--duration", o->duration, format("Stop after this much audio (s, up to %g); default: until Ctrl-C", kLongestDuration))
+  sub->add_option("-t,--duration", o->duration,
+                  format("Stop after this much audio (s, up to %g); default: until Ctrl-C", kLongestDuration))
       ->type_name("T")
       ->check(duration_in_seconds());
   sub->add_option("--gain", o->gain, "m/s of v0 per unit of RMS above the noise floor (0 to 1e6)")
@@ -65,7 +66,8 @@ Runner add_mic(CLI::App& app) {
       ->check(integer_in(8000, 192000));
   sub->add_option("--csv", o->csv, "Write v0 over audio time as \"t,v0\" rows (s, m/s), usable by --wind-speed")
       ->type_name("FILE");
-  sub->add_option("--interval", o->interval, "Audio time between CSV rows (s, at least one sample, up to 3600)")
+  sub->add_option("--interval", o->interval,
+                  format("Audio time between CSV rows (s, at least one sample, up to %g)", kLongestSpeedInterval))
       ->type_name("S")
       ->capture_default_str()
       ->check(number_in(1.0 / 192000, kLongestSpeedInterval));  // one sample at the highest --rate

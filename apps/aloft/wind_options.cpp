@@ -251,16 +251,13 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
 
 WindDriver make_file_wind(const Model& model, const WindSourceSpec& source, std::size_t index, const WindOptions& o,
                           double timestep) {
-  WindSettings settings = settings_from_flags(o);
-  if (source.alpha) settings.alpha = *source.alpha;
-  else if (o.alpha > 0 && !acceptable_wind_alpha(o.alpha, source.l0))  // the flag's alpha, for this source's l0
+  if (!source.alpha && o.alpha > 0 && !acceptable_wind_alpha(o.alpha, source.l0))  // the flag's, for its l0
     throw Failure(model.file + ": " + source.path + " (l0 = " + format("%g", source.l0) +
                   " m) takes --wind-alpha, which " + wind_alpha_rule(source.l0) + ", got " + format("%g", o.alpha));
-  if (source.beta) settings.beta = *source.beta;
-  settings.seed = source.seed ? *source.seed : static_cast<std::uint64_t>(o.seed) + 1 + index;
+  const WindSettings settings = file_source_settings(source, index, settings_from_flags(o));
   WindDriver d;
   try {
-    d.wind = std::make_unique<Wind>(model, WindSource::aimed(source.from, source.to, source.r0, source.l0), settings);
+    d.wind = std::make_unique<Wind>(model, file_source_cone(source), settings);
   } catch (const std::invalid_argument& e) {
     throw Failure(model.file + ": " + source.path + ": " + e.what());
   }

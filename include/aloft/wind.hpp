@@ -102,6 +102,13 @@ struct WindSettings {
   void validate() const;      // throws std::invalid_argument naming the bad setting
 };
 
+// A wind source of the mobile file (spec.hpp) as the command line, the viewer and fuzz_mobile_simulate
+// blow it: its cone, WindSource::aimed(from, to, r0, l0) (which throws as aimed does), and its settings:
+// `run`'s, with the file's alpha, beta and seed where it gives them. A source without a seed takes
+// run.seed + 1 + index (its place in the file), so that two sources do not gust in step.
+WindSource file_source_cone(const WindSourceSpec& source);
+WindSettings file_source_settings(const WindSourceSpec& source, std::size_t index, WindSettings run);
+
 // One area element that sees the wind: a part of one plane of one component.
 struct WindElement {
   int component = 0;

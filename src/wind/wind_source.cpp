@@ -98,6 +98,17 @@ WindSource source_facing_mobile(const Model& model, const State& state, const Ve
   return source_covering(cover.center - distance * along.normalized(), cover.center, l0, cover);
 }
 
+WindSource file_source_cone(const WindSourceSpec& source) {
+  return WindSource::aimed(source.from, source.to, source.r0, source.l0);
+}
+
+WindSettings file_source_settings(const WindSourceSpec& source, std::size_t index, WindSettings run) {
+  if (source.alpha) run.alpha = *source.alpha;
+  if (source.beta) run.beta = *source.beta;
+  run.seed = source.seed ? *source.seed : run.seed + 1 + index;
+  return run;
+}
+
 WindSource source_in_front(const Model& model, const State& state, double l0) {
   return source_facing_mobile(model, state, Vec3(0, 0, -1), kFrontSourceDistance, l0);
 }

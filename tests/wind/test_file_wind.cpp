@@ -193,6 +193,40 @@ TEST(FileWindCli, FlagsWindAndFileSourcesBlowTogether) {
   EXPECT_NE(r.output.find("occlusion         6 refreshes"), std::string::npos) << r.output;
 }
 
+// A file source blows with the run's settings and its own alpha, beta and seed where it gives them; one
+// without a seed takes the run's + 1 + its index, so that two sources do not gust in step.
+TEST(FileWindSettings, FileSourcesTakeTheRunsSettingsAndTheirOwn) {
+  WindSettings run;
+  run.alpha = 2;
+  run.beta = 0.1;
+  run.seed = 10;
+  run.resolution = 64;
+  WindSourceSpec plain;
+  const WindSettings a = file_source_settings(plain, 3, run);
+  EXPECT_EQ(a.alpha, 2);
+  EXPECT_EQ(a.beta, 0.1);
+  EXPECT_EQ(a.seed, 14u);
+  EXPECT_EQ(a.resolution, 64);
+  WindSourceSpec own = plain;
+  own.alpha = 0.5;
+  own.beta = 0.7;
+  own.seed = 99;
+  const WindSettings b = file_source_settings(own, 3, run);
+  EXPECT_EQ(b.alpha, 0.5);
+  EXPECT_EQ(b.beta, 0.7);
+  EXPECT_EQ(b.seed, 99u);
+  EXPECT_EQ(b.resolution, 64);
+  own.from = Vec3(1, 1, 0);
+  own.to = Vec3(0, 1, 0);
+  own.r0 = 0.2;
+  own.l0 = 0.5;
+  const WindSource cone = file_source_cone(own);
+  EXPECT_EQ(cone.disc_center(), own.from);  // vertex l0 behind from, along the unit x axis: exact
+  EXPECT_EQ(cone.direction, Vec3(-1, 0, 0));
+  EXPECT_EQ(cone.r0, 0.2);
+  EXPECT_EQ(cone.l0, 0.5);
+}
+
 // --wind-alpha also sets the alpha of file sources that give none, so it is checked against each one's
 // l0: the fan room's fan has l0 = 1.2 m, so water's alpha 1000 * 1.2^4 = 2073.6 kg m. (With no --wind
 // there is no wind of the flags' own to check it against --wind-l0 for.)

@@ -260,13 +260,13 @@ void MobileSession::build_file_winds(const std::vector<FileWind>& before) {
     w.enabled = file_winds_on_load_;
     for (const FileWind& old : before)
       if (old.source.name == w.source.name) w.enabled = old.enabled;  // a reload keeps the switch
-    WindSettings settings = wind_control.settings;
-    settings.alpha = w.source.alpha.value_or(-1);   // air for its own l0 unless the file says
-    settings.beta = w.source.beta.value_or(WindSettings{}.beta);
-    settings.seed = w.source.seed.value_or(wind_control.settings.seed + 1 + i);  // as aloft simulate's default
+    // The window's resolution, tile, gust time and seed; air for the source's own l0 and the default
+    // turbulence unless the file says.
+    WindSettings run = wind_control.settings;
+    run.alpha = -1;
+    run.beta = WindSettings{}.beta;
     try {
-      w.wind = std::make_unique<Wind>(*model_, WindSource::aimed(w.source.from, w.source.to, w.source.r0, w.source.l0),
-                                      settings);
+      w.wind = std::make_unique<Wind>(*model_, file_source_cone(w.source), file_source_settings(w.source, i, run));
     } catch (const std::exception& e) {
       error_ = "wind source \"" + w.source.name + "\": " + e.what();
     }
