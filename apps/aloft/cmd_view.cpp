@@ -37,9 +37,10 @@ Runner add_view(CLI::App& app) {
   sub->add_option("--time-scale", o->viewer.time_scale, "Simulated seconds per second (1/64 to 4; 1: real time; < 1: slow motion)")
       ->capture_default_str()
       ->check(number_in(1.0 / 64, 4.0));
-  sub->add_option("--breeze", o->viewer.breeze, "Steady wind speed v0 at S0 at start (m/s, 0 to 20)")
+  sub->add_option("--breeze", o->viewer.breeze,
+                  format("Steady wind speed v0 at S0 at start (m/s, 0 to %g)", view::kStrongestBreeze))
       ->capture_default_str()
-      ->check(number_in(0.0, 20.0));
+      ->check(number_in(0.0, view::kStrongestBreeze));
   sub->add_flag("--no-wind", o->no_wind, "Start with the wind off (W toggles it)");
   sub->add_flag("--no-mic", o->no_mic, "Do not open the microphone");
   add_no_file_wind_flag(sub, o->no_file_wind);

@@ -311,6 +311,9 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
       {"render small.json -t 1 --target nan 0 0 --out x.png",
        "--target: must be a number from -1000 to 1000, got \"nan\""},
       {"render small.json -t 1 --yaw nan --out x.png", "--yaw: must be a finite number, got nan"},
+      // The viewer's breeze flag and its panel's slider share one limit (view/mobile_session.hpp:
+      // kStrongestBreeze); the slider used to stop at 10 m/s while the flag took 20.
+      {"view small.json --breeze 25", "--breeze: must be a number from 0 to 20, got \"25\""},
       // alpha up to water's density times l0^4 (spec.hpp: kDensestWind): 1000 * 0.5^4 = 62.5 kg m.
       {"simulate small.json -t 1 --wind 1 --wind-l0 0.5 --wind-alpha 100",
        "--wind-alpha: must be a positive number of at most 62.5 kg m: alpha = rho l0^4, and with l0 = 0.5 m that "

@@ -39,6 +39,10 @@ struct BuildSettings {
   std::optional<bool> contact_enabled;
 };
 
+// The strongest steady breeze the viewer offers (m/s at S0): the limit of `aloft view --breeze` and of
+// the panel's breeze slider, and the full scale of its speed bar.
+inline constexpr double kStrongestBreeze = 20.0;
+
 #if ALOFT_HAVE_WIND
 // The wind as the viewer drives it: a source aimed at the mobile, a steady breeze, gusts and the
 // microphone's speed added together.
@@ -49,7 +53,7 @@ struct WindControl {
   double distance = 2.5;              // m from the mobile's centre to S0
   double r0 = 0.0;                    // m; 0: wide enough to cover the mobile (source_facing_mobile)
   double l0 = 1.0;                    // m
-  double breeze = 0.0;                // m/s: steady v0
+  double breeze = 0.0;                // m/s: steady v0 (0 to kStrongestBreeze)
   double mic_v0 = 0.0;                // m/s from the microphone (set by the window layer)
   double gust_peak = 4.0;             // m/s added by a gust at its start, decaying
   double gust_time = 0.7;             // s, decay time constant of a gust

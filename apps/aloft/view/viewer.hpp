@@ -22,7 +22,7 @@ struct ViewerOptions {
   // Applied to the framing camera after the file's "camera" (the flags: they override the file per key).
   std::function<render::OrbitCamera(render::OrbitCamera)> adjust_camera;
   bool wind = true;                      // the wind module (if built in) on at start
-  double breeze = 0;                     // m/s, steady wind at start
+  double breeze = 0;                     // m/s, steady wind at start (0 to kStrongestBreeze)
   bool show_cone = false;                // the wind cone drawn at start (K toggles it)
   bool show_occlusion = false;           // what the wind reaches drawn at start (O toggles it)
   bool microphone = true;                // open the default capture device (its absence is fine)

@@ -283,9 +283,10 @@ void ViewerState::draw_panel() {
     if (ImGui::Button("From me")) w.follow_camera = true;
     ImGui::EndDisabled();
     float breeze = static_cast<float>(w.breeze);
-    if (bounded_slider("breeze v0 (m/s)", breeze, 0.0f, 10.0f, "%.2f")) w.breeze = breeze;
+    if (bounded_slider("breeze v0 (m/s)", breeze, 0.0f, static_cast<float>(kStrongestBreeze), "%.2f"))
+      w.breeze = breeze;
     const double v0 = session->v0();
-    ImGui::ProgressBar(static_cast<float>(std::min(v0 / 10, 1.0)), ImVec2(-1, 0),
+    ImGui::ProgressBar(static_cast<float>(std::min(v0 / kStrongestBreeze, 1.0)), ImVec2(-1, 0),
                        (std::to_string(static_cast<int>(std::lround(v0 * 100)) / 100.0).substr(0, 4) + " m/s at S0").c_str());
     float r0 = static_cast<float>(w.r0), l0 = static_cast<float>(w.l0);
     if (bounded_slider("r0 (m)", r0, 0.05f, 3.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) w.r0 = r0;
