@@ -154,16 +154,8 @@ CLI::Validator integer_in(long long lo, long long hi) {
 }
 
 CLI::Validator timestep_range() {
-  return CLI::Validator(
-      [](std::string& input) -> std::string {
-        const std::optional<double> parsed = read_number(input);
-        if (!parsed) return "must be a number of seconds, got \"" + input + "\"";
-        const double v = *parsed;
-        if (!(v >= kShortestTimestep && v <= kLongestTimestep))
-          return format("must be from %g to %g s, got ", kShortestTimestep, kLongestTimestep) + input;
-        return {};
-      },
-      "");
+  return finite_number_between(kShortestTimestep, true, kLongestTimestep,
+                               format("from %g to %g s", kShortestTimestep, kLongestTimestep));
 }
 
 }  // namespace aloft::cli
