@@ -128,7 +128,7 @@ OrbitCamera framing_camera(const SceneMesh& scene, double aspect) {
   const double half_height = (top - b.min.y()) / 2 + 0.1;
   const double half_width = scene.reach + 0.1;
   camera.target = Vec3((b.min.x() + b.max.x()) / 2, (top + b.min.y()) / 2 - 0.1, scene.hook.z());
-  camera.yaw = 0.28;
+  camera.yaw = 0.28;  // rad (16 degrees): from a little to the right (+x) of the front (+z)
   camera.pitch = 0.12;
   const double t = std::tan(camera.fov_y / 2);
   camera.distance = 1.05 * std::max(half_height / t, half_width / (t * std::max(aspect, 0.2))) + 0.5 * scene.reach;

@@ -1,7 +1,7 @@
 #pragma once
 // Camera flags shared by `aloft render` and `aloft view`: every one optional; what is not given comes
 // from the mobile file's "camera" (file_camera.hpp), and what that does not give from the framing camera
-// (the whole mobile in view, a little from the left and above).
+// (the whole mobile in view, a little from the right and above).
 
 #include <cmath>
 #include <numbers>
