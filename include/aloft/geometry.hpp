@@ -21,10 +21,14 @@ struct MassProperties {
 
 // Combine solids given with *absolute* inertias (already multiplied by their densities): the result's
 // `volume` holds the total mass, `center` the combined centre of mass, `inertia` the parallel-axis sum.
+// Moments are summed about the first part's centre, not the world origin: a part far from the origin
+// (a 0.1 mm ball 1.8 m up) would otherwise lose its own inertia to round-off when shifted back.
 struct MassAccumulator {
+  int parts = 0;
   double mass = 0;
-  Vec3 first_moment = Vec3::Zero();       // sum m_i c_i
-  Mat3 second_moment = Mat3::Zero();      // sum of inertias about the world origin
+  Vec3 reference = Vec3::Zero();          // the first part's centre (world, m)
+  Vec3 first_moment = Vec3::Zero();       // sum m_i (c_i - reference)
+  Mat3 second_moment = Mat3::Zero();      // sum of inertias about the reference
   void add(double mass, const Vec3& center, const Mat3& inertia_about_center);
   Vec3 center() const;                    // requires mass > 0
   Mat3 inertia_about_center() const;      // requires mass > 0

@@ -290,17 +290,19 @@ MassProperties MassProperties::scaled_inertia(double density) const {
 }
 
 void MassAccumulator::add(double m, const Vec3& c, const Mat3& inertia_about_c) {
+  if (parts++ == 0) reference = c;
   mass += m;
-  first_moment += m * c;
-  // Parallel axis theorem: I_origin = I_c + m (|c|^2 1 - c c^T).
-  second_moment += inertia_about_c + m * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+  const Vec3 d = c - reference;
+  first_moment += m * d;
+  // Parallel axis theorem: I_reference = I_c + m (|d|^2 1 - d d^T).
+  second_moment += inertia_about_c + m * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
 }
 
-Vec3 MassAccumulator::center() const { return first_moment / mass; }
+Vec3 MassAccumulator::center() const { return reference + first_moment / mass; }
 
 Mat3 MassAccumulator::inertia_about_center() const {
-  const Vec3 c = center();
-  return second_moment - mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+  const Vec3 d = first_moment / mass;  // the centre from the reference
+  return second_moment - mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
 }
 
 MassProperties polyhedron_mass_properties(const TriangleMesh& mesh) {

@@ -214,6 +214,13 @@ Model compile(const MobileSpec& spec) {
     Mat3 axes = eig.eigenvectors();                 // columns: principal axes in world
     if (axes.determinant() < 0) axes.col(2) *= -1;  // a proper rotation
     model.principal_moments[i] = eig.eigenvalues();
+    if (i > 0 && !(model.principal_moments[i].minCoeff() > 0 && model.principal_moments[i].allFinite())) {
+      std::ostringstream why;
+      why << "the component's inertia is not positive (principal moments " << model.principal_moments[i].x() << ", "
+          << model.principal_moments[i].y() << ", " << model.principal_moments[i].z()
+          << " kg m^2): its shapes are too small or too thin to compute in double precision";
+      fail(spec, c.path + ".shapes", why.str());
+    }
     model.rest_orientation[i] = Quat(axes).normalized();
     model.color[i] = c.color;
     model.restitution[i] = c.restitution.value_or(spec.contact.restitution);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -350,6 +351,36 @@ TEST(MassProperties, AccumulatorAppliesParallelAxisTheorem) {
   got.center = acc.center();
   got.inertia = acc.inertia_about_center();
   expect_same(got, want, 1e-9, "two halves");
+}
+
+// A small part far from the world origin keeps its own inertia: the accumulator sums moments about its
+// first part's centre. Summed about the origin, a 0.1 mm ball 1.8 m up lost its 2/5 m r^2 to round-off
+// (m |c|^2 ~ 1e8 times larger), and a 1e-10 m ball got negative moments and a NaN at the first step.
+TEST(MassProperties, AccumulatorKeepsTheInertiaOfSmallPartsFarFromTheOrigin) {
+  for (const double radius : {1e-4, 1e-7, 1e-10}) {
+    Sphere ball;
+    ball.radius = radius;
+    ball.center = Vec3(-0.5, 1.8, 700);
+    const MassProperties mp = sphere_mass_properties(ball);
+    MassAccumulator one;
+    one.add(mp.volume, mp.center, mp.inertia);
+    // 1e-12 relative: one part, so only the centre's round-off (|c| eps ~ 1.6e-13 m, squared) enters.
+    EXPECT_NEAR((one.inertia_about_center() - mp.inertia).norm() / mp.inertia.norm(), 0, 1e-12) << radius;
+    // Two balls a diameter apart: about their midpoint each adds m r^2, so 2 (2/5 + 1) m r^2 across the
+    // line joining them and 2 (2/5) m r^2 along it. The offset 2r is known to |x| eps = 0.5 eps m, so to
+    // 0.5 eps / (2r) relative, and its square twice that: 10 times that bound (about origin, the error was
+    // m |c|^2 eps / (m r^2), 5e-3 at r = 1e-4 m).
+    const double tolerance = 10 * 0.5 * std::numeric_limits<double>::epsilon() / radius;
+    Sphere other = ball;
+    other.center.x() += 2 * radius;
+    MassAccumulator two;
+    two.add(mp.volume, ball.center, mp.inertia);
+    two.add(mp.volume, other.center, mp.inertia);
+    const double m = mp.volume, r2 = radius * radius;
+    const Vec3 want(2 * 0.4 * m * r2, 2 * 1.4 * m * r2, 2 * 1.4 * m * r2);
+    const Mat3 got = two.inertia_about_center();
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got(k, k) / want[k], 1, tolerance) << radius << " axis " << k;
+  }
 }
 
 TEST(MassProperties, InsideOutMeshHasNegativeVolume) {
