@@ -10,10 +10,10 @@ namespace aloft::internal {
 
 namespace {
 
-// Projection onto the horizontal plane (perpendicular to gravity).
+// Projection onto the horizontal plane (perpendicular to gravity): the lever arms gravity acts on.
 Mat3 horizontal_projector(const Vec3& gravity) {
   const double g = gravity.norm();
-  if (g == 0) return Mat3::Identity();  // no gravity: every pose is an equilibrium of gravity
+  if (g == 0) return Mat3::Zero();  // no gravity: no arm, every pose is an equilibrium
   const Vec3 down = gravity / g;
   return Mat3::Identity() - down * down.transpose();
 }
@@ -121,14 +121,31 @@ BalanceResult balance(const BalanceInput& in, BalanceMode mode, std::optional<do
               << " from the vertical through its joint; put the joint at " << format_point(above)
               << " (above the centre of mass) or use balance mode \"joints\"";
         } else {
-          why << "cannot balance with positive masses: around its joint " << format_point(in.joint[i])
-              << ", the weight of '" << in.names[i] << "'";
-          if (x(0) <= 1e-6) why << " itself";
-          for (size_t j = 0; j < in.children[i].size(); ++j)
-            if (x(j + 1) <= 1e-6) why << (x(0) <= 1e-6 ? " and of '" : " and of what hangs from '")
-                                      << in.names[in.children[i][j]] << "'";
-          why << " would have to be zero or negative: the pieces hanging from it do not lie on both sides "
-                 "of the joint; move the joint between them, or use balance mode \"joints\"";
+          // The factors closest to all ones: none negative means a balance exists, but one part would weigh
+          // less than a millionth of what its shapes and density give (the parts' masses differ too much
+          // for their arms); a negative one means the parts do not lie on both sides of the joint.
+          const bool too_unequal = smallest > 0;
+          why << (too_unequal ? "cannot balance with masses within a factor 1e6 of the drawn ones: around its joint "
+                              : "cannot balance with positive masses: around its joint ")
+              << format_point(in.joint[i]) << ", the weight of ";
+          const char* separator = "";
+          if (x(0) <= 1e-6) {
+            why << "'" << in.names[i] << "' itself";
+            separator = " and of ";
+          }
+          for (size_t j = 0; j < in.children[i].size(); ++j) {
+            const int child = in.children[i][j];
+            if (x(j + 1) > 1e-6) continue;
+            why << separator << "'" << in.names[child] << "'" << (in.children[child].empty() ? "" : " with what hangs from it");
+            separator = " and of ";
+          }
+          if (too_unequal)
+            why << " would have to be " << std::setprecision(3) << 1 / smallest
+                << " times less than its shapes and density give: the parts' masses are too unequal for the "
+                   "arms they hang from; move the joint towards the heavier side, or use balance mode \"joints\"";
+          else
+            why << " would have to be zero or negative: the pieces hanging from it do not lie on both sides "
+                   "of the joint; move the joint between them, or use balance mode \"joints\"";
         }
         fail(in.paths[i] + ".joint", why.str());
       }

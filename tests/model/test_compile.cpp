@@ -1,4 +1,5 @@
-// Compiling a mobile file's components: mass properties that keep small parts' inertia.
+// Compiling a mobile file's components: mass properties that keep small parts' inertia, and balance
+// modes that name the right cause when they cannot balance (or have nothing to balance: no gravity).
 
 #include <gtest/gtest.h>
 
@@ -65,6 +66,43 @@ TEST(Compile, InertiaBelowDoublePrecisionIsRefused) {
       compile_error(bar_mobile("none", R"({"sphere": {"center": [-0.5, 1.8, 0], "radius": 1e-80}})", kBall));
   EXPECT_EQ(e.place().path, "components[2].shapes") << e.what();
   EXPECT_NE(e.problem().find("the component's inertia is not positive"), std::string::npos) << e.what();
+}
+
+TEST(Compile, WithoutGravityEveryPoseBalances) {
+  // 'a' hangs 0.3 m off its joint's vertical: under gravity "mass" cannot balance it and "joints" moves
+  // its joint. Without gravity there is no arm: both keep the design and the densities' mass ratios.
+  const std::string off = R"({"sphere": {"center": [-0.2, 1.7, 0], "radius": 0.05}},
+                             {"wire": {"from": [-0.5, 1.8, 0], "to": [-0.2, 1.7, 0], "radius": 0.0005}})";
+  EXPECT_NE(compile_error(bar_mobile("mass", off, kBall)).problem().find("cannot balance"), std::string::npos);
+  const Model none = compile_text(bar_mobile("none", off, kBall, R"("gravity": [0, 0, 0],)"));
+  for (const std::string mode : {"mass", "joints"}) {
+    const Model m = compile_text(bar_mobile(mode, off, kBall, R"("gravity": [0, 0, 0],)"));
+    EXPECT_EQ(m.balance.max_imbalance, 0) << mode;
+    for (int i = 1; i < m.count; ++i) {
+      // 1e-12 relative: "none" and the balance modes scale the same base masses to the same total.
+      EXPECT_NEAR(m.mass[i] / none.mass[i], 1, 1e-12) << mode << " " << m.names[i];
+      EXPECT_EQ(m.joint_world[i], none.joint_world[i]) << mode << " " << m.names[i];
+    }
+  }
+}
+
+TEST(Compile, BalanceNamesWhyItCannot) {
+  // A 0.1 mm bead against a 4 kg ball on equal arms: a balance exists, but the ball would have to weigh
+  // 1e8 times less than drawn. It used to say the pieces do not lie on both sides of the joint.
+  const InputError unequal = compile_error(
+      bar_mobile("mass", R"({"sphere": {"center": [-0.5, 1.8, 0], "radius": 1e-4}})", kBall));
+  EXPECT_EQ(unequal.place().path, "components[1].joint") << unequal.what();
+  EXPECT_NE(unequal.problem().find("the weight of 'b' would have to be"), std::string::npos) << unequal.what();
+  EXPECT_NE(unequal.problem().find("masses are too unequal"), std::string::npos) << unequal.what();
+  EXPECT_EQ(unequal.problem().find("both sides"), std::string::npos) << unequal.what();
+
+  // Both children on the right of the bar's joint: no positive masses balance it.
+  std::string one_sided = bar_mobile("mass", R"({"sphere": {"center": [0.2, 1.55, 0], "radius": 0.05}},
+      {"wire": {"from": [0.2, 1.8, 0], "to": [0.2, 1.6, 0], "radius": 0.0005}})", kBall);
+  one_sided.replace(one_sided.find("[-0.5, 1.8, 0], \"shapes\""), 14, "[0.2, 1.8, 0]");
+  const InputError sided = compile_error(one_sided);
+  EXPECT_EQ(sided.place().path, "components[1].joint") << sided.what();
+  EXPECT_NE(sided.problem().find("do not lie on both sides of the joint"), std::string::npos) << sided.what();
 }
 
 }  // namespace
