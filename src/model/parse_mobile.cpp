@@ -29,6 +29,7 @@
 
 #include "aloft/geometry.hpp"
 #include "aloft/spec.hpp"
+#include "common/regular_file.hpp"
 #include "model/format_keys.hpp"
 #include "model/json_locator.hpp"
 
@@ -794,8 +795,8 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   std::error_code ec;
   const fs::file_status status = fs::status(resolved, ec);
   if (!fs::exists(status)) fail(op, resolved + ": no such file");
-  if (!fs::is_regular_file(status)) fail(op, resolved + ": not a regular file");
   try {
+    require_regular_file(resolved);  // "<resolved>: not a regular file"
     m.mesh = read_obj(resolved);
   } catch (const InputError& e) {
     fail(op, e.what());

@@ -423,6 +423,18 @@ TEST(Parse, MeshFileMissing) {
                dir.path().string());
 }
 
+// A directory or a device is named as not a regular file (common/regular_file.hpp, shared with the WAV and
+// speed CSV readers); /dev/zero used to be read until memory ran out.
+TEST(Parse, MeshFileThatIsNotARegularFile) {
+  TempDir dir;
+  fs::create_directory(dir.path() / "fish.obj");
+  const std::string text = with_shape(R"({"mesh": {"obj": "fish.obj"}})");
+  expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "fish.obj"), "fish.obj: not a regular file",
+               dir.path().string());
+  const std::string zero = with_shape(R"({"mesh": {"obj": "/dev/zero"}})");
+  expect_error(zero, "components[1].shapes[0].mesh.obj", line_of(zero, "zero"), "/dev/zero: not a regular file");
+}
+
 TEST(Parse, MeshIsPlacedAndScaled) {
   TempDir dir;
   dir.write("tet.obj", std::string(kTetrahedronVertices) + kTetrahedronFaces);
