@@ -10,6 +10,8 @@
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
 #include "aloft/spec.hpp"
+#include "common/decimal_number.hpp"
+#include "common/regular_file.hpp"
 
 namespace aloft {
 
@@ -31,19 +33,22 @@ std::string trim(const std::string& s) {
   return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
 }
 
-// A whole field as a finite double, or nothing.
-bool parse_number(const std::string& field, double& out) {
+// What is wrong with a field that is not a plain decimal number, beyond its not being one: hexadecimal
+// (std::strtod read "0x10" as 16) or not finite ("inf", "nan", "1e400"); empty when nothing more is known.
+std::string number_problem(const std::string& field, NumberResult result, const char* name) {
   const std::string text = trim(field);
-  if (text.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && errno == 0 && std::isfinite(out);
+  if (result == NumberResult::not_finite) return std::string(name) + " must be a finite number, got " + text;
+  std::string_view digits = without_plus(text);
+  if (!digits.empty() && digits[0] == '-') digits.remove_prefix(1);
+  if (digits.size() > 1 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
+    return std::string(name) + " must be a decimal number, got the hexadecimal " + text;
+  return "";
 }
 
 }  // namespace
 
 SpeedSeries read_speed_csv(const std::string& path) {
+  require_regular_file(path);  // /dev/zero or a FIFO was read until memory ran out
   std::ifstream in(path);
   if (!in) throw InputError(path, {}, std::string("cannot open the speed series: ") + std::strerror(errno));
   SpeedSeries series;
@@ -51,16 +56,23 @@ SpeedSeries read_speed_csv(const std::string& path) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
+    // A UTF-8 byte order mark (what some spreadsheets write first) is no part of the first row.
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const std::string text = trim(line);
     if (text.empty() || text[0] == '#') continue;
     const auto comma = text.find(',');
     auto fail = [&](const std::string& problem) { throw InputError(path, SourcePlace{"", number, 0}, problem); };
     if (comma == std::string::npos) fail("expected \"t,v0\" (time in s, speed in m/s), got \"" + text + "\"");
     double t = 0, v = 0;
-    const bool t_ok = parse_number(text.substr(0, comma), t);
-    const bool v_ok = parse_number(text.substr(comma + 1), v);
-    if (!t_ok || !v_ok) {
-      if (series.t.empty() && !t_ok && !v_ok) continue;  // a header line such as "t,v0"
+    const NumberResult t_read = parse_double(trim(text.substr(0, comma)), t);
+    const NumberResult v_read = parse_double(trim(text.substr(comma + 1)), v);
+    const std::string t_problem = number_problem(text.substr(0, comma), t_read, "the time t");
+    const std::string v_problem = number_problem(text.substr(comma + 1), v_read, "the speed v0");
+    if (!t_problem.empty()) fail(t_problem);
+    if (!v_problem.empty()) fail(v_problem);
+    if (t_read != NumberResult::ok || v_read != NumberResult::ok) {
+      // A header line such as "t,v0": neither field a number.
+      if (series.t.empty() && t_read != NumberResult::ok && v_read != NumberResult::ok) continue;
       fail("expected two numbers \"t,v0\", got \"" + text + "\"");
     }
     if (!acceptable_wind_speed(v)) fail("the speed v0 " + wind_speed_rule() + ", got " + trim(text.substr(comma + 1)));

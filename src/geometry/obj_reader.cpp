@@ -19,6 +19,7 @@
 
 #include "aloft/error.hpp"
 #include "aloft/geometry.hpp"
+#include "common/decimal_number.hpp"
 
 namespace aloft {
 namespace {
@@ -46,29 +47,6 @@ std::string quoted(std::string_view s) {
   }
   if (s.size() > kMax) out += "...";
   return out + "'";
-}
-
-// from_chars does not take a leading '+'; OBJ writers sometimes emit one.
-std::string_view without_plus(std::string_view s) {
-  if (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
-  return s;
-}
-
-enum class NumberResult { ok, not_a_number, not_finite };
-
-NumberResult parse_double(std::string_view s, double& value) {
-  s = without_plus(s);
-  const char* end = s.data() + s.size();
-  const auto r = std::from_chars(s.data(), end, value, std::chars_format::general);
-  if (r.ptr != end || s.empty()) return NumberResult::not_a_number;
-  if (r.ec == std::errc::result_out_of_range) {
-    // Too large (non-finite) or too small (rounds to zero or a subnormal: acceptable); strtod tells which.
-    const std::string copy(s);
-    value = std::strtod(copy.c_str(), nullptr);
-    return std::isfinite(value) ? NumberResult::ok : NumberResult::not_finite;
-  }
-  if (r.ec != std::errc()) return NumberResult::not_a_number;
-  return std::isfinite(value) ? NumberResult::ok : NumberResult::not_finite;
 }
 
 // A whole token as a decimal integer (optional sign).

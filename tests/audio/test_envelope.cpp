@@ -163,5 +163,57 @@ TEST(SpeedSeries, CsvReaderReportsFileAndLine) {
   std::remove(path.c_str());
 }
 
+// Numbers are decimal (common/decimal_number.hpp, as in OBJ files): std::strtod read "0x10" as 16 s, and a
+// first row "inf,nan" passed for a header. A UTF-8 byte order mark is no part of the first row.
+TEST(SpeedSeries, CsvReaderReadsDecimalNumbersOnly) {
+  const std::string path = ::testing::TempDir() + "aloft_speeds_decimal.csv";
+  auto read = [&](const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+    return read_speed_csv(path);
+  };
+  auto message = [&](const std::string& text) {
+    try {
+      read(text);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // The BOM before a data row (it used to read as "expected two numbers") and before a header.
+  SpeedSeries s = read("\xEF\xBB\xBF" "0,1\n2,3\n");
+  ASSERT_EQ(s.t.size(), 2u);
+  EXPECT_EQ(s.t[0], 0.0);
+  EXPECT_EQ(s.v0[0], 1.0);
+  s = read("\xEF\xBB\xBF" "t,v0\n0,1\n");
+  ASSERT_EQ(s.t.size(), 1u);
+  EXPECT_EQ(s.v0[0], 1.0);
+  // Only the first line's: one further on is a bad row.
+  EXPECT_EQ(message("0,1\n\xEF\xBB\xBF" "1,2\n"), path + ":2: expected two numbers \"t,v0\", got \"\xEF\xBB\xBF" "1,2\"");
+  EXPECT_EQ(message("0x10,1\n"), path + ":1: the time t must be a decimal number, got the hexadecimal 0x10");
+  EXPECT_EQ(message("0,1\n1,-0X1\n"), path + ":2: the speed v0 must be a decimal number, got the hexadecimal -0X1");
+  EXPECT_EQ(message("inf,1\n"), path + ":1: the time t must be a finite number, got inf");
+  EXPECT_EQ(message("0,1\n1, nan\n"), path + ":2: the speed v0 must be a finite number, got nan");
+  EXPECT_EQ(message("nan,nan\n0,1\n"), path + ":1: the time t must be a finite number, got nan");  // no header
+  EXPECT_EQ(message("0,1\n1e400,1\n"), path + ":2: the time t must be a finite number, got 1e400");
+  // Too small for a double (1e-400 m/s) reads as 0, as in OBJ files: no speed that small matters.
+  s = read("0,1e-400\n+1,2\n");
+  ASSERT_EQ(s.t.size(), 2u);
+  EXPECT_EQ(s.v0[0], 0.0);
+  EXPECT_EQ(s.t[1], 1.0);  // a leading '+' is read, as std::strtod read it
+  std::remove(path.c_str());
+}
+
+// Input files are read whole: /dev/zero or a FIFO was read until memory ran out, without the file named.
+TEST(SpeedSeries, CsvReaderReadsOnlyRegularFiles) {
+  for (const std::string& path : {std::string("/dev/zero"), ::testing::TempDir()}) {
+    try {
+      read_speed_csv(path);
+      ADD_FAILURE() << path << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), path + ": not a regular file");
+    }
+  }
+}
+
 }  // namespace
 }  // namespace aloft::test
