@@ -29,8 +29,10 @@ struct AudioClip {
 
 // Read a RIFF/WAVE file: PCM 8/16/24/32-bit integer or IEEE float 32/64-bit (also WAVE_FORMAT_EXTENSIBLE),
 // 1 to 8 channels. Throws InputError naming the file, the byte offset and what is wrong (not a RIFF file,
-// truncated chunk, unsupported encoding, no data chunk, a float sample that is a NaN, infinite or beyond
-// +-1000, 60 dB above full scale: not sound, ...).
+// truncated chunk, unsupported encoding, no data chunk, a data chunk without a whole frame, a float sample
+// that is a NaN, infinite or beyond +-1000, 60 dB above full scale: not sound, ...), or "not a regular
+// file" (a device or FIFO, which has no end). An odd-sized chunk without its pad byte is read when the next
+// tag shows it (see parse_wav).
 AudioClip read_wav(const std::string& path);
 // The same from bytes in memory (`name` is used in messages).
 AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& name);
@@ -89,8 +91,10 @@ struct SpeedSeries {
   double duration() const { return t.empty() ? 0 : t.back(); }
 };
 
-// "t,v0" rows (an optional header line, '#' comments and blank lines allowed). Throws InputError naming the
-// file and line for a bad number, a negative speed or times not increasing.
+// "t,v0" rows (an optional header line, '#' comments and blank lines allowed; a UTF-8 byte order mark at the
+// start is skipped). Numbers are decimal, as in OBJ files (no hexadecimal, inf or nan; 1e-400 reads as 0).
+// Throws InputError naming the file and line for a bad number, a negative speed or times not increasing,
+// or "not a regular file".
 SpeedSeries read_speed_csv(const std::string& path);
 
 // Feeds an EnvelopeFollower and records v0 every `interval` seconds of *audio* time (the follower's value

@@ -13,6 +13,7 @@
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
 #include "common/little_endian.hpp"
+#include "common/regular_file.hpp"
 
 namespace aloft {
 
@@ -38,6 +39,28 @@ struct Reader {
   std::uint16_t u16(std::size_t at) const { return little_endian_u16(bytes.data() + at); }
   std::uint32_t u32(std::size_t at) const { return little_endian_u32(bytes.data() + at); }
   bool tag(std::size_t at, const char* four) const { return std::memcmp(bytes.data() + at, four, 4) == 0; }
+  // Whether the four bytes at `at` can be a chunk tag: printable ASCII (RIFF tags are letters, digits and
+  // spaces).
+  bool plausible_tag(std::size_t at) const {
+    return std::all_of(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + 4),
+                       [](std::uint8_t c) { return c >= 0x20 && c < 0x7f; });
+  }
+  // The tag at `at` for a message, in quotes, every byte that is not printable ASCII (and the quote and
+  // backslash) as \xNN: a damaged tag's NUL byte used to cut the message short.
+  std::string tag_text(std::size_t at) const {
+    std::string out = "\"";
+    for (std::size_t i = at; i < at + 4; ++i) {
+      const std::uint8_t c = bytes[i];
+      if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+        out += static_cast<char>(c);
+      } else {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "\\x%02X", static_cast<unsigned>(c));
+        out += hex;
+      }
+    }
+    return out + "\"";
+  }
 };
 
 // A sample's value for a message: "1e+30", "-1234.5".
@@ -90,6 +113,14 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
   std::uint16_t format = 0, channels = 0, bits = 0, block_align = 0;
   std::uint32_t rate = 0;
   std::size_t at = 12;
+  std::size_t odd_chunk = 0;  // byte offset of the chunk before `at` when that one is of odd size (0: not)
+  // " (it follows the odd-sized chunk at byte N, ...)" when the chunk at `at` follows one of odd size, whose
+  // pad byte may be missing and so have shifted the reading by one byte.
+  const auto after_odd_chunk = [&] {
+    return odd_chunk == 0 ? std::string()
+                          : " (it follows the odd-sized " + r.tag_text(odd_chunk) + " chunk at byte " +
+                                std::to_string(odd_chunk) + ", whose pad byte may be missing)";
+  };
   while (at + 8 <= bytes.size()) {
     const std::uint32_t size = r.u32(at + 4);
     const std::size_t body = at + 8;
@@ -97,9 +128,8 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
     if (static_cast<std::uint64_t>(body) + size > bytes.size()) {
       // A truncated data chunk (a recording cut short) keeps its whole frames; any other truncation is fatal.
       if (!is_data)
-        r.fail(at, "truncated file: the \"" + std::string(reinterpret_cast<const char*>(bytes.data() + at), 4) +
-                       "\" chunk claims " + std::to_string(size) + " bytes, " + std::to_string(bytes.size() - body) +
-                       " are left");
+        r.fail(at, "truncated file: the " + r.tag_text(at) + " chunk claims " + std::to_string(size) + " bytes, " +
+                       std::to_string(bytes.size() - body) + " are left" + after_odd_chunk());
     }
     if (r.tag(at, "fmt ")) {
       if (size < 16) r.fail(at, "the \"fmt \" chunk is " + std::to_string(size) + " bytes, at least 16 are needed");
@@ -130,6 +160,22 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
       if (!have_format) r.fail(at, "the \"data\" chunk comes before any \"fmt \" chunk");
       const std::size_t available = std::min<std::size_t>(size, bytes.size() - body);
       const std::size_t frames = available / block_align;
+      if (frames == 0) {
+        // No samples: v0 would be 0 throughout, a run without wind and without a word.
+        if (size == 0 && bytes.size() >= body + 8 && r.tag(body, "data"))
+          r.fail(at, "the \"data\" chunk declares 0 bytes, so the file holds no samples (another \"data\" chunk "
+                     "follows at byte " + std::to_string(body) + ": a WAV file holds one)");
+        if (size == 0 && bytes.size() > body)
+          r.fail(at, "the \"data\" chunk declares 0 bytes, so the file holds no samples (" +
+                         std::to_string(bytes.size() - body) +
+                         " bytes follow it: if they are the samples, the recorder never wrote the chunk's size)");
+        if (size == 0) r.fail(at, "the \"data\" chunk is empty (0 bytes): the file holds no samples");
+        r.fail(at, "the \"data\" chunk " +
+                       (available < size ? "declares " + std::to_string(size) + " bytes, but the file ends after " +
+                                               std::to_string(available) + " of them"
+                                         : "holds " + std::to_string(available) + " bytes") +
+                       ", less than one frame (" + std::to_string(block_align) + " bytes): the file holds no samples");
+      }
       AudioClip clip;
       clip.file = name;
       clip.sample_rate = static_cast<int>(rate);
@@ -151,13 +197,27 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
       }
       return clip;
     }
-    at = body + size + (size & 1);  // chunks are padded to even sizes
+    // Chunks are padded to even sizes. Some writers leave the pad byte out: when the byte after an odd-sized
+    // chunk starts a chunk header with a plausible tag and the byte after it does not, the pad is missing
+    // and the next chunk starts at once. (Read with the pad, its tag would be three bytes of the real tag and
+    // one of its size, often not a character at all, and its size a misreading.)
+    std::uint64_t next = static_cast<std::uint64_t>(body) + size;
+    odd_chunk = 0;
+    if (size & 1) {
+      odd_chunk = at;
+      const bool unpadded = next + 8 <= bytes.size() && r.plausible_tag(next) &&
+                            !(next + 9 <= bytes.size() && r.plausible_tag(next + 1));
+      if (!unpadded) ++next;
+    }
+    if (next >= bytes.size()) break;
+    at = static_cast<std::size_t>(next);
   }
   if (!have_format) r.fail(12, "no \"fmt \" chunk: not a usable WAV file");
   r.fail(bytes.size(), "no \"data\" chunk: the file holds no samples");
 }
 
 AudioClip read_wav(const std::string& path) {
+  require_regular_file(path);  // /dev/zero or a FIFO was read until memory ran out
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, {}, std::string("cannot open the audio file: ") + std::strerror(errno));
   std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

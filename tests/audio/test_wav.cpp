@@ -2,8 +2,10 @@
 // naming the file and what is wrong, never a crash.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 
@@ -142,6 +144,100 @@ TEST(WavReader, FloatSamplesThatAreNotSoundAreNamed) {
   put32(f64, static_cast<std::uint32_t>(du >> 32));
   const std::string wide = message_of(wav_bytes(3, 1, 48000, 64, f64));
   EXPECT_NE(wide.find("byte 44: float sample 0 is 1e+300"), std::string::npos) << wide;
+}
+
+// A file without a single sample frame gave v0 = 0 throughout: a run without wind and without a word. It is
+// named at its "data" chunk, which starts at byte 36 in these files (12 of RIFF header, 24 of "fmt ").
+TEST(WavReader, AFileWithoutSamplesIsNamedAtItsDataChunk) {
+  const std::vector<std::uint8_t> empty = wav_bytes(1, 1, 48000, 16, {});  // the 44-byte header alone
+  ASSERT_EQ(empty.size(), 44u);
+  EXPECT_EQ(message_of(empty), "bad.wav: byte 36: the \"data\" chunk is empty (0 bytes): the file holds no samples");
+  // Size 0 with the samples after it (a streaming writer that never wrote the size back): not guessed at,
+  // since an empty chunk may as well be followed by other chunks.
+  std::vector<std::uint8_t> unsized = wav_bytes(1, 1, 48000, 16, std::vector<std::uint8_t>(8, 0x10));
+  std::memset(unsized.data() + 40, 0, 4);
+  EXPECT_EQ(message_of(unsized), "bad.wav: byte 36: the \"data\" chunk declares 0 bytes, so the file holds no samples "
+                                 "(8 bytes follow it: if they are the samples, the recorder never wrote the chunk's "
+                                 "size)");
+  // An empty "data" chunk, then a real one: the first is the file's data.
+  std::vector<std::uint8_t> twice(empty);
+  put_tag(twice, "data");
+  put32(twice, 4);
+  for (int i = 0; i < 4; ++i) twice.push_back(0x10);
+  EXPECT_EQ(message_of(twice), "bad.wav: byte 36: the \"data\" chunk declares 0 bytes, so the file holds no samples "
+                               "(another \"data\" chunk follows at byte 44: a WAV file holds one)");
+  // Less than one frame: 3 bytes of a stereo 16-bit file (4 bytes a frame), or a chunk cut before its first.
+  EXPECT_EQ(message_of(wav_bytes(1, 2, 48000, 16, {1, 2, 3})),
+            "bad.wav: byte 36: the \"data\" chunk holds 3 bytes, less than one frame (4 bytes): the file holds no "
+            "samples");
+  std::vector<std::uint8_t> cut = wav_bytes(1, 1, 48000, 16, std::vector<std::uint8_t>(8, 0));
+  cut.resize(45);
+  EXPECT_EQ(message_of(cut), "bad.wav: byte 36: the \"data\" chunk declares 8 bytes, but the file ends after 1 of "
+                             "them, less than one frame (2 bytes): the file holds no samples");
+}
+
+// The 16-bit samples 0.25, -0.5 as bytes (exact in 16 bits).
+std::vector<std::uint8_t> two_samples() {
+  std::vector<std::uint8_t> data;
+  put16(data, 8192);
+  put16(data, static_cast<std::uint16_t>(-16384));
+  return data;
+}
+
+// An odd-sized chunk written without its pad byte: the "LIST" chunk of wav_bytes(..., extra_chunk) is 3
+// bytes at byte 36, its pad at byte 47, "data" at byte 48.
+TEST(WavReader, AnOddChunkWithoutItsPadByteIsReadWhenTheNextTagShowsIt) {
+  const std::vector<std::uint8_t> padded = wav_bytes(1, 1, 48000, 16, two_samples(), false, true);
+  ASSERT_EQ(padded[47], 0);
+  ASSERT_EQ(std::memcmp(padded.data() + 48, "data", 4), 0);
+  std::vector<std::uint8_t> unpadded(padded);
+  unpadded.erase(unpadded.begin() + 47);
+  // Read with the pad, the tag would be "ata\x04" (the size's low byte): not a tag; "data" is one byte sooner.
+  const AudioClip clip = parse_wav(unpadded, "nopad.wav");
+  ASSERT_EQ(clip.samples.size(), 2u);
+  EXPECT_EQ(clip.samples[0], 0.25f);  // exact in 16 bits
+  EXPECT_EQ(clip.samples[1], -0.5f);
+  // A pad byte that is a printable character is still a pad when a tag follows it.
+  std::vector<std::uint8_t> spaced(padded);
+  spaced[47] = 'x';  // "xdat" would be a plausible tag too, but "data" after the pad is one
+  EXPECT_EQ(parse_wav(spaced, "spaced.wav").samples.size(), 2u);
+  // When the size's low byte is a character (72 = 'H'), "ataH" looks like a tag: the reading goes on with
+  // the pad, meets a chunk far too long, and the message names the odd-sized chunk before it.
+  std::vector<std::uint8_t> long_data;
+  for (int i = 0; i < 36; ++i) put16(long_data, 0x1010);  // 72 bytes
+  std::vector<std::uint8_t> shifted = wav_bytes(1, 1, 48000, 16, long_data, false, true);
+  shifted.erase(shifted.begin() + 47);
+  EXPECT_EQ(message_of(shifted),
+            "bad.wav: byte 48: truncated file: the \"ataH\" chunk claims 268435456 bytes, 71 are left (it follows "
+            "the odd-sized \"LIST\" chunk at byte 36, whose pad byte may be missing)");
+}
+
+// A damaged tag's NUL byte cut the message short ("truncated file: the \""): tags are printed with every
+// byte that is not printable ASCII, and the quote and backslash, as \xNN.
+TEST(WavReader, ChunkTagsInMessagesAreEscaped) {
+  std::vector<std::uint8_t> bytes = wav_bytes(1, 1, 48000, 16, two_samples());
+  bytes.resize(36);  // up to the end of "fmt "
+  const std::uint8_t tag[4] = {'a', 0, '"', 0xFF};
+  bytes.insert(bytes.end(), tag, tag + 4);
+  put32(bytes, 1000);
+  EXPECT_EQ(message_of(bytes), "bad.wav: byte 36: truncated file: the \"a\\x00\\x22\\xFF\" chunk claims 1000 bytes, "
+                               "0 are left");
+}
+
+// Input files are read whole: /dev/zero or a FIFO was read until memory ran out, without the file named.
+TEST(WavReader, OnlyRegularFilesAreRead) {
+  const std::string fifo = ::testing::TempDir() + "aloft_wav_fifo";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& path : {std::string("/dev/zero"), fifo, ::testing::TempDir()}) {
+    try {
+      read_wav(path);
+      ADD_FAILURE() << path << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), path + ": not a regular file");
+    }
+  }
+  std::remove(fifo.c_str());
 }
 
 TEST(WavReader, GarbageNeverCrashes) {
