@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "aloft/error.hpp"
 #include "aloft/geometry.hpp"
 
 namespace aloft::cli {
@@ -236,6 +237,15 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
     envelope.gain = o.gain;
     envelope.noise_floor = o.noise_floor;
     envelope.calibration_s = o.calibrate;
+    // The follower's v0 is 0 while it calibrates: a recording no longer than the calibration would be the
+    // room's sound throughout, and the run would go without wind and without a word.
+    const double calibration_frames = std::round(o.calibrate * clip.sample_rate);  // as the follower rounds it
+    if (o.noise_floor < 0 && o.calibrate > 0 && static_cast<double>(clip.frames()) <= calibration_frames)
+      throw InputError(o.audio, {},
+                       format("the recording lasts %g s, no longer than the %g s of noise-floor calibration at its "
+                              "start (--wind-calibrate), so no wind would blow; give --wind-calibrate 0 (or a "
+                              "shorter time) or --wind-noise-floor",
+                              clip.duration(), o.calibrate));
     d.series = speed_from_audio(clip, envelope, 0.001);
     double peak = 0;
     for (double v : d.series.v0) peak = std::max(peak, v);

@@ -8,7 +8,9 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "audio/wav_bytes.hpp"
 #include "support/run_aloft.hpp"
 
 namespace aloft::test {
@@ -53,6 +55,53 @@ TEST(WindCli, SpeedSeriesAndAudioDriveTheWind) {
   r = aloft("simulate " + fish + " -t 0.2 --wind-audio /nonexistent/blow.wav");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.output.find("/nonexistent/blow.wav: cannot open the audio file"), std::string::npos) << r.output;
+}
+
+// Bad input files exit 1 with the file named: a WAV without samples, one no longer than its noise-floor
+// calibration, and a file that is not a regular file (/dev/zero was read until memory ran out, "aloft:
+// error: out of memory", no file named). Each of these used to run without wind and without a word.
+TEST(WindCli, AudioAndSpeedFilesThatGiveNoWindAreErrors) {
+  const std::string dir = ::testing::TempDir();
+  const auto write = [&](const std::string& name, const std::vector<std::uint8_t>& bytes) {
+    std::ofstream(dir + name, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                                      static_cast<std::streamsize>(bytes.size()));
+  };
+  write("empty.wav", wav_bytes(1, 1, 8000, 16, {}));
+  Result r = aloft("simulate " + fish + " -t 0.05 --no-collisions --wind-audio " + dir + "empty.wav");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("empty.wav: byte 36: the \"data\" chunk is empty (0 bytes): the file holds no samples"),
+            std::string::npos)
+      << r.output;
+
+  // 0.5 s (4000 frames at 8000 Hz) of a square wave of amplitude 0.5: RMS 0.5, v0 = 25 * 0.5 = 12.5 m/s.
+  std::vector<std::uint8_t> square;
+  for (int i = 0; i < 4000; ++i) put16(square, static_cast<std::uint16_t>(i % 2 == 0 ? 16384 : -16384));
+  write("short.wav", wav_bytes(1, 1, 8000, 16, square));
+  const std::string run = "simulate " + fish + " -t 0.05 --no-collisions --wind-audio " + dir + "short.wav";
+  const std::string why = "short.wav: the recording lasts 0.5 s, no longer than the 1 s of noise-floor calibration "
+                          "at its start (--wind-calibrate), so no wind would blow; give --wind-calibrate 0 (or a "
+                          "shorter time) or --wind-noise-floor";
+  r = aloft(run);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("aloft: error: " + dir + why), std::string::npos) << r.output;
+  r = aloft(run + " --wind-calibrate 0.5");  // as long as the recording: still nothing after it
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("lasts 0.5 s, no longer than the 0.5 s"), std::string::npos) << r.output;
+  // What the message suggests works. The envelope reaches the square's RMS within its 5 ms attack, and the
+  // summary prints 3 significant digits.
+  r = aloft(run + " --wind-noise-floor 0");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("peak v0 12.5 m/s"), std::string::npos) << r.output;
+  r = aloft(run + " --wind-calibrate 0");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("peak v0 12.5 m/s"), std::string::npos) << r.output;
+
+  for (const char* flag : {"--wind-audio", "--wind-speed"}) {
+    r = aloft("simulate " + fish + " -t 0.05 " + flag + " /dev/zero");
+    EXPECT_EQ(r.code, 1) << flag << "\n" << r.output;
+    EXPECT_NE(r.output.find("aloft: error: /dev/zero: not a regular file"), std::string::npos) << flag << "\n"
+                                                                                               << r.output;
+  }
 }
 
 TEST(WindCli, BadFlagsAreUsageErrors) {
