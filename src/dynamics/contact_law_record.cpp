@@ -14,6 +14,7 @@
 
 #include "aloft/error.hpp"
 #include "common/little_endian.hpp"
+#include "common/regular_file.hpp"
 
 namespace aloft {
 
@@ -145,6 +146,7 @@ std::vector<ContactLawRecord> parse_contact_law_records(const std::vector<std::u
 }
 
 std::vector<ContactLawRecord> read_contact_law_records(const std::string& path) {
+  require_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, SourcePlace{}, std::string("cannot open: ") + std::strerror(errno));
   const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

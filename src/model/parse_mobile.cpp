@@ -843,6 +843,7 @@ MobileSpec parse_mobile_file(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InputError(path, {}, "is a directory, not a mobile file");
+  require_regular_file(path);  // /dev/zero or a FIFO would be read until memory ran out
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, {}, "cannot open the file: " + std::error_code(errno, std::generic_category()).message());
   std::ostringstream buffer;

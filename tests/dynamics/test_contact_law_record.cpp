@@ -213,6 +213,13 @@ TEST(ContactLawRecord, AMalformedFileIsRefusedWithTheByteAndTheProblem) {
       << refusal(two.substr(0, two.size() - 3));
 
   EXPECT_THROW(read_contact_law_records("/nonexistent/tangle.law"), InputError);
+  // A device is refused by name (it used to be read until memory ran out).
+  try {
+    read_contact_law_records("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was read";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "/dev/zero: not a regular file");
+  }
 }
 
 }  // namespace

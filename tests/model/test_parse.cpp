@@ -435,6 +435,16 @@ TEST(Parse, MeshFileThatIsNotARegularFile) {
   expect_error(zero, "components[1].shapes[0].mesh.obj", line_of(zero, "zero"), "/dev/zero: not a regular file");
 }
 
+// The mobile file itself likewise: /dev/zero was read until memory ran out ("out of memory", no file named).
+TEST(Parse, MobileFileThatIsNotARegularFile) {
+  try {
+    parse_mobile_file("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was read";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "/dev/zero: not a regular file");
+  }
+}
+
 TEST(Parse, MeshIsPlacedAndScaled) {
   TempDir dir;
   dir.write("tet.obj", std::string(kTetrahedronVertices) + kTetrahedronFaces);
