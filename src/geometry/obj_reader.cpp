@@ -63,7 +63,12 @@ class ObjParser {
   explicit ObjParser(const std::string& file) : file_(file) {}
 
   TriangleMesh parse(const std::string& text) {
-    size_t pos = 0;
+    // UTF-16 (whose byte-order marks are FF FE and FE FF) puts a NUL beside every ASCII character, which
+    // would read as lines of unknown statements and end in "file has no faces".
+    if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
+      fail(1, 1, "the file is UTF-16 (it starts with a UTF-16 byte-order mark); OBJ files must be ASCII or UTF-8");
+    // A UTF-8 byte-order mark is not part of the first line (it would make its keyword unknown).
+    size_t pos = text.starts_with("\xef\xbb\xbf") ? 3 : 0;
     int line = 0;
     while (pos < text.size()) {
       // Lines end with \n, \r\n or \r.
@@ -71,6 +76,9 @@ class ObjParser {
       while (end < text.size() && text[end] != '\n' && text[end] != '\r') ++end;
       if (line == INT_MAX) fail(line, 0, "file has too many lines");
       ++line;
+      if (const void* nul = std::memchr(text.data() + pos, '\0', end - pos))
+        fail(line, column_of(static_cast<const char*>(nul) - (text.data() + pos)),
+             "NUL byte: the file is UTF-16 or not text; OBJ files must be ASCII or UTF-8");
       parse_line(std::string_view(text.data() + pos, end - pos), line);
       // Skip the terminator text[end]: '\n', '\r', or the pair "\r\n".
       pos = end;

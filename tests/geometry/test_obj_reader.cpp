@@ -159,6 +159,52 @@ TEST(ObjReader, FileWithoutFaces) {
   }
 }
 
+// A UTF-8 byte-order mark is skipped: the first line's vertex is read (before, "\xEF\xBB\xBFv" was an
+// unknown statement, and "f 1 2 3" on line 4 was out of range with 2 vertices so far). Columns on the
+// first line do not count the mark.
+TEST(ObjReader, Utf8ByteOrderMarkIsSkipped) {
+  const TriangleMesh m = parse_obj_text("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj");
+  ASSERT_EQ(m.vertices.size(), 3u);
+  EXPECT_EQ(m.vertices[0], Vec3(0, 0, 0));
+  ASSERT_EQ(m.triangles.size(), 1u);
+  try {
+    parse_obj_text("\xEF\xBB\xBFv 0 x 0\n", "bom.obj");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "bom.obj:1:5: expected a number after 'v', got 'x'");
+  }
+  // Only at the start: elsewhere the mark is not whitespace, and the statement is unknown.
+  EXPECT_THROW(parse_obj_text("v 0 0 0\n\xEF\xBB\xBFv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj"), InputError);
+}
+
+// UTF-16 text, with or without its byte-order mark, is refused as such (it used to end in "file has no
+// faces", every line being an unknown statement of letters and NULs).
+TEST(ObjReader, Utf16IsRefusedAsNotUtf8) {
+  const std::string ascii = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::string le, be;
+  for (char c : ascii) {
+    le += std::string{c, '\0'};
+    be += std::string{'\0', c};
+  }
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"\xFF\xFE" + le, "utf16.obj:1:1: the file is UTF-16"},
+      {"\xFE\xFF" + be, "utf16.obj:1:1: the file is UTF-16"},
+      {le, "utf16.obj:1:2: NUL byte: the file is UTF-16 or not text"},
+      {be, "utf16.obj:1:1: NUL byte: the file is UTF-16 or not text"},
+      {ascii + "# a comment" + std::string(1, '\0') + "\n", "utf16.obj:5:12: NUL byte"},  // even in a comment
+  };
+  for (const auto& [text, start] : cases) {
+    try {
+      parse_obj_text(text, "utf16.obj");
+      ADD_FAILURE() << "no error for " << start;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(start, 0), 0u) << what;
+      EXPECT_NE(what.find("OBJ files must be ASCII or UTF-8"), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(ObjReader, MissingFile) {
   const std::string path = (fs::temp_directory_path() / "aloft_no_such_dir" / "fish.obj").string();
   try {
