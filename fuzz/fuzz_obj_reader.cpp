@@ -12,8 +12,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    const aloft::TriangleMesh mesh = aloft::parse_obj_text(text, "fuzz.obj");
-    (void)aloft::closed_mesh_problem(mesh);
+    const aloft::ObjMesh obj = aloft::parse_obj_text(text, "fuzz.obj");
+    (void)aloft::closed_mesh_problem(obj.mesh);
+    aloft::check_closed_obj_mesh(obj, "fuzz.obj");
   } catch (const aloft::InputError&) {
   }
   return 0;

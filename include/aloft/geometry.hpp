@@ -76,9 +76,28 @@ std::optional<std::string> polygon_problem(const std::vector<Vec2>& points);
 // triples into `points`, counter-clockwise in the (u, v) plane.
 std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Vec2>& points);
 
+// Where a triangle read from an OBJ file came from: the 1-based line and column of the face ("f ...")
+// it was fanned from.
+struct FacePlace {
+  int line = 0;
+  int column = 0;
+};
+
+// A mesh read from an OBJ file and its triangles' places in it (faces[t] for mesh.triangles[t]), so
+// that a problem found in the whole mesh can point into the file.
+struct ObjMesh {
+  TriangleMesh mesh;
+  std::vector<FacePlace> faces;
+};
+
 // Read a Wavefront OBJ file (vertices and faces; faces with more than 3 vertices are fanned; other
 // statements ignored). Throws InputError naming the OBJ file and line on malformed input or a missing
-// file. Does not check closure: call closed_mesh_problem.
-TriangleMesh read_obj(const std::string& path);
+// file. Does not check closure: call check_closed_obj_mesh.
+ObjMesh read_obj(const std::string& path);
+
+// closed_mesh_problem's checks on a mesh read from `file`, worded for its author: throws
+// InputError(file, ...) naming vertices by OBJ's 1-based numbers and faces by their lines (a single
+// degenerate face by its line and column in the error's place).
+void check_closed_obj_mesh(const ObjMesh& obj, const std::string& file);
 
 }  // namespace aloft

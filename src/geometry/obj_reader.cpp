@@ -62,7 +62,7 @@ class ObjParser {
  public:
   explicit ObjParser(const std::string& file) : file_(file) {}
 
-  TriangleMesh parse(const std::string& text) {
+  ObjMesh parse(const std::string& text) {
     // UTF-16 (whose byte-order marks are FF FE and FE FF) puts a NUL beside every ASCII character, which
     // would read as lines of unknown statements and end in "file has no faces".
     if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
@@ -88,8 +88,8 @@ class ObjParser {
         if (carriage_return && pos < text.size() && text[pos] == '\n') ++pos;
       }
     }
-    if (mesh_.triangles.empty()) fail(0, 0, "file has no faces");
-    return std::move(mesh_);
+    if (obj_.mesh.triangles.empty()) fail(0, 0, "file has no faces");
+    return std::move(obj_);
   }
 
  private:
@@ -141,8 +141,8 @@ class ObjParser {
       }
       if (k <= 3) p[static_cast<int>(k - 1)] = value;
     }
-    if (mesh_.vertices.size() >= static_cast<size_t>(INT_MAX)) fail(line, 1, "too many vertices");
-    mesh_.vertices.push_back(p);
+    if (obj_.mesh.vertices.size() >= static_cast<size_t>(INT_MAX)) fail(line, 1, "too many vertices");
+    obj_.mesh.vertices.push_back(p);
   }
 
   // One face vertex "a", "a/b", "a/b/c" or "a//c": returns the 0-based vertex index.
@@ -164,7 +164,7 @@ class ObjParser {
     }
     long long index = 0;
     bool overflow = false;
-    const long long count = static_cast<long long>(mesh_.vertices.size());
+    const long long count = static_cast<long long>(obj_.mesh.vertices.size());
     if (!parse_integer(index_text, index, overflow)) {
       if (overflow)
         fail(line, token.column,
@@ -187,22 +187,25 @@ class ObjParser {
     face_.clear();
     for (size_t k = 1; k < tokens_.size(); ++k) face_.push_back(face_vertex(tokens_[k], line));
     // Fan from the first vertex: exact for convex planar polygons, the usual OBJ convention.
-    for (size_t k = 1; k + 1 < face_.size(); ++k) mesh_.triangles.push_back({face_[0], face_[k], face_[k + 1]});
+    for (size_t k = 1; k + 1 < face_.size(); ++k) {
+      obj_.mesh.triangles.push_back({face_[0], face_[k], face_[k + 1]});
+      obj_.faces.push_back({line, tokens_[0].column});
+    }
   }
 
   const std::string& file_;
-  TriangleMesh mesh_;
+  ObjMesh obj_;
   std::vector<Token> tokens_;  // reused across lines
   std::vector<int> face_;      // reused across faces
 };
 
 }  // namespace
 
-TriangleMesh parse_obj_text(const std::string& text, const std::string& file_name_for_messages) {
+ObjMesh parse_obj_text(const std::string& text, const std::string& file_name_for_messages) {
   return ObjParser(file_name_for_messages).parse(text);
 }
 
-TriangleMesh read_obj(const std::string& path) {
+ObjMesh read_obj(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, {}, "cannot open file: it is a directory");
   errno = 0;

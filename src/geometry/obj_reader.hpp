@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "aloft/shapes.hpp"
+#include "aloft/geometry.hpp"
 
 namespace aloft {
 
@@ -14,7 +14,8 @@ namespace aloft {
 // ASCII or UTF-8 (a leading UTF-8 byte-order mark is skipped); UTF-16 (its byte-order mark at 1:1, or
 // a NUL byte where it is) is refused.
 // Throws InputError(file_name_for_messages, {"", line, column}, problem) on malformed input; never
-// crashes or hangs on arbitrary bytes. Runs in time linear in the text's length.
-TriangleMesh parse_obj_text(const std::string& text, const std::string& file_name_for_messages);
+// crashes or hangs on arbitrary bytes. Runs in time linear in the text's length. Each triangle's place
+// (ObjMesh::faces) is that of its face's 'f'.
+ObjMesh parse_obj_text(const std::string& text, const std::string& file_name_for_messages);
 
 }  // namespace aloft

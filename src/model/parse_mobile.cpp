@@ -795,20 +795,26 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   std::error_code ec;
   const fs::file_status status = fs::status(resolved, ec);
   if (!fs::exists(status)) fail(op, resolved + ": no such file");
+  ObjMesh obj;
   try {
     require_regular_file(resolved);  // "<resolved>: not a regular file"
-    m.mesh = read_obj(resolved);
+    obj = read_obj(resolved);
   } catch (const InputError& e) {
     fail(op, e.what());
   }
-  for (Vec3& p : m.mesh.vertices) {
+  for (Vec3& p : obj.mesh.vertices) {
     p = p.cwiseProduct(scale) + translate;  // scale, then translate
     if (!(p.cwiseAbs().maxCoeff() <= kLongestLength))  // (NaN fails too)
       fail(op, resolved + ": a vertex lies at [" + format_number(p.x()) + ", " + format_number(p.y()) + ", " +
                    format_number(p.z()) + "] m once scaled and moved, more than " + format_number(kLongestLength) +
                    " m from the origin (no mobile is larger)");
   }
-  if (auto problem = closed_mesh_problem(m.mesh)) fail(op, resolved + ": " + *problem);
+  try {
+    check_closed_obj_mesh(obj, resolved);
+  } catch (const InputError& e) {
+    fail(op, e.what());
+  }
+  m.mesh = std::move(obj.mesh);
   return m;
 }
 

@@ -265,6 +265,40 @@ TEST_F(Cli, BadFilesExitOneWithFileAndLine) {
   EXPECT_NE(r.err.find("no-such-dir/x.json"), std::string::npos) << r.err;
 }
 
+// A mesh's problem found once the whole mesh is read still names the mobile file's place and the OBJ
+// file's, and the OBJ's own line and vertex numbers (from 1); the exit code is 1.
+TEST_F(Cli, BadMeshNamesBothFilesAndTheFace) {
+  // A unit cube (six quads on lines 9-14) and a face using vertex 1 twice on line 15, in place of the
+  // ball's sphere (line 15 of the mobile) at a tenth of its size.
+  const std::string cube =
+      "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\n"
+      "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n"
+      "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+  write(dir_ / "deg.obj", cube + "f 1 1 2\n");
+  write(dir_ / "open.obj", cube.substr(0, cube.rfind("f 5 6 8 7")));
+  std::string text = kSmallMobile;
+  const std::string sphere = R"({"sphere": {"center": [0.5, 1.54, 0], "radius": 0.06}})";
+  text.replace(text.find(sphere), sphere.size(), R"({"mesh": {"obj": "deg.obj", "scale": 0.1, "translate": [0.5, 1.54, 0]}})");
+  write(dir_ / "deg.json", text);
+  Result r = aloft("inspect deg.json");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("aloft: error: deg.json:15:", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(": components[3].shapes[1].mesh.obj: deg.obj:15:1: face is degenerate (zero area): vertex 1 "
+                       "appears twice\n"),
+            std::string::npos)
+      << r.err;
+
+  text.replace(text.find("deg.obj"), 7, "open.obj");
+  write(dir_ / "open.json", text);
+  r = aloft("inspect open.json");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("aloft: error: open.json:15:", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(": components[3].shapes[1].mesh.obj: open.obj: the edge between vertices 5 and 7 belongs to "
+                       "only one face (line 9): the mesh is not closed\n"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(Cli, UsageErrorsExitTwo) {
   write(dir_ / "small.json", kSmallMobile);
   for (const char* args : {"", "frobnicate", "generate", "generate -n 1", "generate -n 10 --total-mass 0",

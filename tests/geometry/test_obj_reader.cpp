@@ -56,7 +56,7 @@ const char* kCube =
 
 TEST(ObjReader, ReadsAGoodFile) {
   const fs::path path = write_temp("cube.obj", kCube);
-  const TriangleMesh m = read_obj(path.string());
+  const TriangleMesh m = read_obj(path.string()).mesh;
   ASSERT_EQ(m.vertices.size(), 8u);
   ASSERT_EQ(m.triangles.size(), 12u);
   EXPECT_EQ(m.vertices[7], Vec3(0.5, 0.5, 0.5));
@@ -71,9 +71,24 @@ TEST(ObjReader, ReadsAGoodFile) {
   fs::remove(path);
 }
 
+// Each triangle keeps the line and column of the face it was fanned from, for the closed-mesh check's
+// messages: kCube's six quads are on lines 22 to 27, two triangles each.
+TEST(ObjReader, TrianglesKeepTheirFacesPlace) {
+  const ObjMesh obj = parse_obj_text(kCube, "cube.obj");
+  ASSERT_EQ(obj.faces.size(), obj.mesh.triangles.size());
+  for (size_t t = 0; t < obj.faces.size(); ++t) {
+    EXPECT_EQ(obj.faces[t].line, 22 + static_cast<int>(t / 2)) << t;
+    EXPECT_EQ(obj.faces[t].column, 1) << t;
+  }
+  const ObjMesh indented = parse_obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n\n  \tf 1 2 3\n", "indented.obj");
+  ASSERT_EQ(indented.faces.size(), 1u);
+  EXPECT_EQ(indented.faces[0].line, 5);
+  EXPECT_EQ(indented.faces[0].column, 4);  // the 'f', after two spaces and a tab
+}
+
 TEST(ObjReader, NegativeIndicesAreRelativeToTheVerticesSoFar) {
   const TriangleMesh m = parse_obj_text(
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf -3 -2 -1\nf 1 -1 -4\n", "rel.obj");
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf -3 -2 -1\nf 1 -1 -4\n", "rel.obj").mesh;
   ASSERT_EQ(m.triangles.size(), 3u);
   EXPECT_EQ(m.triangles[0], (std::array<int, 3>{0, 1, 2}));
   EXPECT_EQ(m.triangles[1], (std::array<int, 3>{3, 4, 5}));
@@ -163,7 +178,7 @@ TEST(ObjReader, FileWithoutFaces) {
 // unknown statement, and "f 1 2 3" on line 4 was out of range with 2 vertices so far). Columns on the
 // first line do not count the mark.
 TEST(ObjReader, Utf8ByteOrderMarkIsSkipped) {
-  const TriangleMesh m = parse_obj_text("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj");
+  const TriangleMesh m = parse_obj_text("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj").mesh;
   ASSERT_EQ(m.vertices.size(), 3u);
   EXPECT_EQ(m.vertices[0], Vec3(0, 0, 0));
   ASSERT_EQ(m.triangles.size(), 1u);
@@ -224,8 +239,10 @@ TEST(ObjReader, MissingFile) {
 // Whatever the bytes, parsing either returns a mesh whose indices are all in range or throws InputError.
 void expect_parses_or_rejects(const std::string& text) {
   try {
-    const TriangleMesh m = parse_obj_text(text, "junk.obj");
+    const ObjMesh obj = parse_obj_text(text, "junk.obj");
+    const TriangleMesh& m = obj.mesh;
     ASSERT_FALSE(m.triangles.empty());
+    ASSERT_EQ(obj.faces.size(), m.triangles.size());
     for (const auto& t : m.triangles)
       for (int k : t) ASSERT_TRUE(k >= 0 && k < static_cast<int>(m.vertices.size()));
     for (const Vec3& v : m.vertices) ASSERT_TRUE(v.allFinite());

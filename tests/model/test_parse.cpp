@@ -468,8 +468,25 @@ TEST(Parse, MeshOpen) {
   dir.write("open.obj", std::string(kTetrahedronVertices) + "f 1 3 2\nf 1 2 4\nf 1 4 3\n");  // a face missing
   const std::string text = with_shape(R"({"mesh": {
           "obj": "open.obj"}})");
-  expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "open.obj"), "open.obj: ",
+  // The mobile file's place, then the OBJ file's path and its face's line (the edge 2-3 of the missing
+  // face "f 2 3 4" is first met in "f 1 3 2" on line 5).
+  expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "open.obj"),
+               "open.obj: the edge between vertices 2 and 3 belongs to only one face (line 5): the mesh is not closed",
                dir.path().string());
+}
+
+// A degenerate face: both places, the mobile file's and the OBJ's line and column of the face.
+TEST(Parse, MeshDegenerateFaceNamesItsLine) {
+  TempDir dir;
+  dir.write("deg.obj", std::string(kTetrahedronVertices) + kTetrahedronFaces + "f 1 2 -3\n");  // vertex 2 twice
+  const std::string text = with_shape(R"({"mesh": {
+          "obj": "deg.obj"}})");
+  const std::string what = expect_error(text, "components[1].shapes[0].mesh.obj", line_of(text, "deg.obj"),
+                                        "deg.obj:9:1: face is degenerate (zero area): vertex 2 appears twice",
+                                        dir.path().string());
+  EXPECT_NE(what.find(": components[1].shapes[0].mesh.obj: " + (dir.path() / "deg.obj").string() + ":9:1: face"),
+            std::string::npos)
+      << what;
 }
 
 // Sizes no mobile has (aloft/spec.hpp: kLongestLength, the total mass and density ranges) are refused
