@@ -42,8 +42,8 @@ struct Reader {
   // Whether the four bytes at `at` can be a chunk tag: printable ASCII (RIFF tags are letters, digits and
   // spaces).
   bool plausible_tag(std::size_t at) const {
-    return std::all_of(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + 4),
-                       [](std::uint8_t c) { return c >= 0x20 && c < 0x7f; });
+    const auto first = bytes.begin() + static_cast<std::ptrdiff_t>(at);
+    return std::all_of(first, first + 4, [](std::uint8_t c) { return c >= 0x20 && c < 0x7f; });
   }
   // The tag at `at` for a message, in quotes, every byte that is not printable ASCII (and the quote and
   // backslash) as \xNN: a damaged tag's NUL byte used to cut the message short.
@@ -174,7 +174,8 @@ AudioClip parse_wav(const std::vector<std::uint8_t>& bytes, const std::string& n
                        (available < size ? "declares " + std::to_string(size) + " bytes, but the file ends after " +
                                                std::to_string(available) + " of them"
                                          : "holds " + std::to_string(available) + " bytes") +
-                       ", less than one frame (" + std::to_string(block_align) + " bytes): the file holds no samples");
+                       ", less than one frame (" + std::to_string(block_align) +
+                       " bytes): the file holds no samples");
       }
       AudioClip clip;
       clip.file = name;

@@ -181,13 +181,14 @@ void check_closed_obj_mesh(const ObjMesh& obj, const std::string& file) {
     case Defect::non_finite_vertex:
       throw error("vertex " + number(d->index) + " has a non-finite coordinate");
     case Defect::index_out_of_range:
-      throw error("face index " + std::to_string(d->index + 1) + " out of range (" + std::to_string(mesh.vertices.size()) +
-               " vertices)",
-           place(obj, d->triangle));
+      throw error("face index " + std::to_string(d->index + 1) + " out of range (" +
+                      std::to_string(mesh.vertices.size()) + " vertices)",
+                  place(obj, d->triangle));
     case Defect::degenerate: {
       const int t = d->triangle;
       const auto& tri = mesh.triangles[t];
-      std::string why = "vertices " + number(tri[0]) + ", " + number(tri[1]) + " and " + number(tri[2]) + " lie on a line";
+      std::string why =
+          "vertices " + number(tri[0]) + ", " + number(tri[1]) + " and " + number(tri[2]) + " lie on a line";
       for (int k = 0; k < 3; ++k) {
         const int u = tri[k], w = tri[(k + 1) % 3];
         if (u == w) why = "vertex " + number(u) + " appears twice";
@@ -206,7 +207,8 @@ void check_closed_obj_mesh(const ObjMesh& obj, const std::string& file) {
       throw error("face is degenerate (zero area): " + why, place(obj, t));
     }
     case Defect::open_edge:
-      throw error(edge + " belongs to only one face (" + line_list(obj, {d->triangle}) + "): the mesh is not closed");
+      throw error(edge + " belongs to only one face (" + line_list(obj, {d->triangle}) +
+                  "): the mesh is not closed");
     case Defect::non_manifold_edge: {
       std::vector<int> users;
       for (int t = 0; t < nt; ++t)
@@ -215,12 +217,13 @@ void check_closed_obj_mesh(const ObjMesh& obj, const std::string& file) {
               std::max(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]) == std::max(d->a, d->b))
             users.push_back(t);
       throw error(edge + " is used by " + std::to_string(d->count) + " triangles (of the faces on " +
-           line_list(obj, users) + "): not a manifold surface");
+                  line_list(obj, users) + "): not a manifold surface");
     }
     case Defect::misoriented:
       throw error("the faces on " + line_list(obj, {d->triangle, d->other}) + " both run from vertex " +
-           number(d->a) + " to vertex " + number(d->b) +
-           ": they are oriented inconsistently (faces sharing an edge must run along it in opposite directions)");
+                  number(d->a) + " to vertex " + number(d->b) +
+                  ": they are oriented inconsistently (faces sharing an edge must run along it in opposite "
+                  "directions)");
     case Defect::no_volume:
       throw error(kNoVolume);
     case Defect::inside_out:

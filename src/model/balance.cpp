@@ -136,7 +136,8 @@ BalanceResult balance(const BalanceInput& in, BalanceMode mode, std::optional<do
           for (size_t j = 0; j < in.children[i].size(); ++j) {
             const int child = in.children[i][j];
             if (x(j + 1) > 1e-6) continue;
-            why << separator << "'" << in.names[child] << "'" << (in.children[child].empty() ? "" : " with what hangs from it");
+            why << separator << "'" << in.names[child] << "'"
+                << (in.children[child].empty() ? "" : " with what hangs from it");
             separator = " and of ";
           }
           if (too_unequal)
