@@ -151,6 +151,10 @@ Runner add_simulate(CLI::App& app) {
       "Exit code 3 if the simulation fails (its state stops being finite); the CSVs then hold the\n"
       "frames and contacts computed until then.\n");
   return [o] {
+    check_outputs_apart({{"the mobile file", o->file},
+                         {"--wind-audio's recording", o->wind.audio},
+                         {"--wind-speed's table", o->wind.speed_csv}},
+                        {{"--out", o->out}, {"--contacts-out", o->contacts_out}});
     LoadedMobile loaded = load_mobile_with_spec(o->file, o->balance);
     Model& model = loaded.model;
     if (o->no_collisions) model.contact.enabled = false;

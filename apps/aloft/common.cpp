@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <vector>
 
@@ -71,6 +72,31 @@ void write_file(const std::string& path, const std::string& text) {
   const int err = written == text.size() ? 0 : errno;
   if (std::fclose(f) != 0 || written != text.size())
     throw Failure("cannot write " + path + ": " + std::strerror(err ? err : EIO));
+}
+
+namespace {
+
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec), cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ec && ca == cb;
+}
+
+}  // namespace
+
+void check_outputs_apart(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs) {
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    const NamedFile& out = outputs[k];
+    if (out.path.empty()) continue;
+    for (const NamedFile& in : inputs)
+      if (!in.path.empty() && same_file(out.path, in.path))
+        throw Failure(out.name + ": " + out.path + " is " + in.name + "; writing it would destroy it");
+    for (std::size_t j = 0; j < k; ++j)
+      if (!outputs[j].path.empty() && same_file(out.path, outputs[j].path))
+        throw Failure(out.name + ": " + out.path + " is also " + outputs[j].name + "'s file; give each its own");
+  }
 }
 
 std::string source_dir() {

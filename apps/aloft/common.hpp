@@ -78,6 +78,16 @@ bool is_terminal(std::FILE* stream);
 // A whole file written at once, or a Failure naming it.
 void write_file(const std::string& path, const std::string& text);
 
+// A file a command reads or writes, and what it is: {"--out", "run.csv"}, {"the mobile file", "m.json"}.
+struct NamedFile {
+  std::string name;
+  std::string path;  // empty: not given
+};
+// Throws a Failure when an output names the same file as an input (writing it would destroy the input:
+// simulate m.json -o m.json) or as another output (one would overwrite the other). Same file: the same
+// path once made absolute and normal, or, when both exist, the same inode (a link).
+void check_outputs_apart(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
+
 // Directory of the source tree this program was built from (for the preset mobiles).
 std::string source_dir();
 

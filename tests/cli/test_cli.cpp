@@ -188,6 +188,28 @@ TEST_F(Cli, SimulateWritesTrajectory) {
   EXPECT_EQ(quiet.out, "");
 }
 
+// An output never lands on an input or on the other output: "-o m.json" used to replace the mobile file
+// with the trajectory (exit 0), and "-o a.csv --contacts-out a.csv" left only the contacts.
+TEST_F(Cli, OutputsNeverOverwriteTheInputs) {
+  write(dir_ / "small.json", kSmallMobile);
+  const std::pair<const char*, const char*> cases[] = {
+      {"simulate small.json -t 0.01 -o small.json", "--out: small.json is the mobile file; writing it would destroy it"},
+      {"simulate small.json -t 0.01 --contacts-out ./small.json", "--contacts-out: ./small.json is the mobile file"},
+      {"simulate small.json -t 0.01 -o a.csv --contacts-out sub/../a.csv",
+       "--contacts-out: sub/../a.csv is also --out's file; give each its own"},
+  };
+  fs::create_directory(dir_ / "sub");
+  for (const auto& [args, message] : cases) {
+    const Result r = aloft(args);
+    EXPECT_EQ(r.code, 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+  }
+  EXPECT_EQ(read(dir_ / "small.json"), kSmallMobile);
+  EXPECT_FALSE(fs::exists(dir_ / "a.csv"));
+  // Two different outputs still work.
+  EXPECT_EQ(aloft("simulate small.json -t 0.01 -q -o a.csv --contacts-out b.csv").code, 0);
+}
+
 TEST_F(Cli, SimulateQuotesNames) {
   write(dir_ / "small.json", kSmallMobile);
   const Result r = aloft("simulate small.json -t 0.002 -k 1 -o t.csv -q");
