@@ -112,6 +112,12 @@ TEST_F(FileCamera, FileCameraIsUsedAndFlagsOverrideItKeyByKey) {
   const std::string as_flags = camera_flags();
   ASSERT_EQ(render(no_camera_, "flags.png", as_flags), 0);
   EXPECT_EQ(differing_pixels(file, load_png(dir_ / "flags.png")), 0);
+  // --target also takes X,Y,Z, as --wind-from does.
+  const auto& target = camera_.at("target");
+  std::string with_commas = as_flags.substr(0, as_flags.find("--target"));
+  with_commas += "--target " + target[0].dump() + "," + target[1].dump() + "," + target[2].dump();
+  ASSERT_EQ(render(no_camera_, "commas.png", with_commas), 0);
+  EXPECT_EQ(differing_pixels(file, load_png(dir_ / "commas.png")), 0);
 
   // One flag overrides one key: --yaw 60 on the file == all the file's keys as flags but yaw 60.
   ASSERT_EQ(render(fan_room_, "file-yaw.png", "--yaw 60"), 0);
