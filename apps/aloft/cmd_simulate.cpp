@@ -271,6 +271,19 @@ Runner add_simulate(CLI::App& app) {
                     model.count);
       std::fflush(stdout);
     }
+    // Without wind nothing gives the mobile energy (damping and contacts only take it out): a gain of more
+    // than 1 % of its energy scale, a thousand times the integrator's error on the presets and generated
+    // mobiles (1e-5), means the motion is wrong. docs/architecture.md, "Known limits".
+    if (wind.empty()) {
+      const State& s = sim.state();
+      const double gain = kinetic_energy(model, s) + potential_energy(model, s) - e0;
+      const double scale = std::max(std::abs(e0 - e_rest), peak_kinetic);  // J
+      if (scale > 0 && gain > 0.01 * scale)
+        print_warning(format("the mobile gained %.3g J, %.3g %% of its energy scale (%.3g J), with no wind to give "
+                             "it: the simulation is inaccurate here and its motion not to be trusted (see "
+                             "docs/architecture.md, \"Known limits\")",
+                             gain, 100 * gain / scale, scale));
+    }
     return kExitOk;
   };
 }

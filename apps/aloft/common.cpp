@@ -21,6 +21,11 @@ void print_error(const std::string& message) {
   std::fprintf(stderr, "aloft: error: %s\n", message.c_str());
 }
 
+void print_warning(const std::string& message) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "aloft: warning: %s\n", message.c_str());
+}
+
 void append_double(std::string& out, double value) {
   char buffer[32];
   const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);

@@ -57,6 +57,8 @@ aloft::Model load_mobile_as(const std::string& file, const std::string& balance_
 
 // "aloft: error: <message>" on stderr.
 void print_error(const std::string& message);
+// "aloft: warning: <message>" on stderr: the run went on, but what it gave is not to be trusted.
+void print_warning(const std::string& message);
 
 // Shortest text that reads back as the same double (std::to_chars), e.g. "0.1", "1e-07".
 std::string format_double(double value);
