@@ -266,6 +266,36 @@ TEST(Collisions, RestingContactNeitherJittersNorSinks) {
   EXPECT_LT(std::abs(removed), 1e-6);
 }
 
+// Two 5 cm balls on 0.5 m threads, e = 1 and mu = 10: A swings into B, they trade speeds (the first knock),
+// and 0.7 s later swing back into each other. In the step before that second knock the balls are met as a
+// speculative contact, slowed from 1.14 to 0.93 m/s to close their gap within the step. Until 2026-12-07
+// that slowing counted as a pair pressed together at 1.14 m/s, and a pressed pair bounces only when it
+// approaches faster than twice that: the knock came out plastic, both balls stopped and the contacts took
+// out all 2.7 J. What a speculative contact stops is the approach less what it may close (0.21 m/s).
+TEST(Collisions, AKnockMetFirstAsASpeculativeContactStillBounces) {
+  const Model model = model_from(R"({"name": "two balls", "contact": {"restitution": 1, "friction": 10},
+    "components": [
+      {"name": "hook", "fixed": true, "shapes": [{"wire": {"from": [-0.5, 2, 0], "to": [0.5, 2, 0], "radius": 0.005}}]},
+      {"name": "A", "parent": "hook", "joint": [-0.051, 2, 0], "shapes": [
+        {"wire": {"from": [-0.051, 2, 0], "to": [-0.276, 1.6102885682970025, 0], "radius": 0.001}},
+        {"sphere": {"center": [-0.301, 1.5669872981077806, 0], "radius": 0.05}}]},
+      {"name": "B", "parent": "hook", "joint": [0.051, 2, 0], "shapes": [
+        {"wire": {"from": [0.051, 2, 0], "to": [0.051, 1.55, 0], "radius": 0.001}},
+        {"sphere": {"center": [0.051, 1.5, 0], "radius": 0.05}}]}]})");
+  Simulation sim(model);
+  sim.set_damping(DampingSpec{});
+  const auto closing = [&] { return sim.state().velocity[1].x() - sim.state().velocity[2].x(); };  // m/s
+  ASSERT_TRUE(sim.advance(1.07));  // after the first knock, before the second (at 1.08 s)
+  const double before = closing();
+  ASSERT_GT(before, 1.0);  // they approach at 1.14 m/s
+  ASSERT_TRUE(sim.advance(0.03));
+  const double after = closing();
+  std::printf("second knock: approach %.3f m/s, then %.3f m/s\n", before, after);
+  // Parting, not stopped. Not at the full 1.14 m/s of e = 1: the speculative step's slowing is not given
+  // back (docs/architecture.md, "Known limits"); measured 0.93 m/s.
+  EXPECT_LT(after, -0.5 * before);
+}
+
 // The leaning balls pressed together by a steady force of `times` their weight each (as a strong wind
 // presses a light plate on a wire, or a tangle's joints press one light piece on another): between two
 // steps they approach at 2 `times` g h, faster than the bounce threshold (2 g h). Until 2026-12-06 each
