@@ -213,18 +213,21 @@ Runner add_simulate(CLI::App& app) {
       return kExitSimulation;
     }
 
+    // The energy the run gained (J), against its scale: the swing it started with or, from rest (a swing
+    // within round-off of the potential), the largest kinetic energy seen; 0 when that too is round-off.
+    const double drift = kinetic_energy(model, sim.state()) + potential_energy(model, sim.state()) - e0;
+    const double swing = std::abs(e0 - e_rest);
+    const bool from_swing = swing > 1e-12 * std::max(1.0, std::abs(e_rest));
+    const double energy_scale = from_swing ? swing : peak_kinetic > 1e-12 ? peak_kinetic : 0.0;
+
     if (!o->quiet) {
       const State& s = sim.state();
       worst_separation = std::max(worst_separation, max_joint_separation(model, s));
-      const double e1 = kinetic_energy(model, s) + potential_energy(model, s);
-      const double drift = e1 - e0;
-      const double swing = std::abs(e0 - e_rest);
       std::string energy = format("%.3e J", drift);
-      if (swing > 1e-12 * std::max(1.0, std::abs(e_rest)))
-        energy += format(" (%.3g %% of the initial swing energy %.3e J)", 100 * drift / swing, swing);
-      else if (peak_kinetic > 1e-12)
-        energy += format(" (%.3g %% of the largest kinetic energy seen, %.3e J)", 100 * drift / peak_kinetic,
-                         peak_kinetic);
+      if (energy_scale > 0)
+        energy += format(from_swing ? " (%.3g %% of the initial swing energy %.3e J)"
+                                    : " (%.3g %% of the largest kinetic energy seen, %.3e J)",
+                         100 * drift / energy_scale, energy_scale);
       // A drift only when nothing else changes the energy: the wind does work and damping takes energy
       // out, so with either the line says what it is and how to check conservation instead.
       const bool damping_on = !o->damping_off && (model.damping.linear > 0 || model.damping.angular > 0);
@@ -274,16 +277,11 @@ Runner add_simulate(CLI::App& app) {
     // Without wind nothing gives the mobile energy (damping and contacts only take it out): a gain of more
     // than 1 % of its energy scale, a thousand times the integrator's error on the presets and generated
     // mobiles (1e-5), means the motion is wrong. docs/architecture.md, "Known limits".
-    if (wind.empty()) {
-      const State& s = sim.state();
-      const double gain = kinetic_energy(model, s) + potential_energy(model, s) - e0;
-      const double scale = std::max(std::abs(e0 - e_rest), peak_kinetic);  // J
-      if (scale > 0 && gain > 0.01 * scale)
-        print_warning(format("the mobile gained %.3g J, %.3g %% of its energy scale (%.3g J), with no wind to give "
-                             "it: the simulation is inaccurate here and its motion not to be trusted (see "
-                             "docs/architecture.md, \"Known limits\")",
-                             gain, 100 * gain / scale, scale));
-    }
+    if (wind.empty() && energy_scale > 0 && drift > 0.01 * energy_scale)
+      print_warning(format("the mobile gained %.3g J, %.3g %% of its energy scale (%.3g J), with no wind to give "
+                           "it: the simulation is inaccurate here and its motion not to be trusted (see "
+                           "docs/architecture.md, \"Known limits\")",
+                           drift, 100 * drift / energy_scale, energy_scale));
     return kExitOk;
   };
 }
