@@ -1,6 +1,7 @@
 #pragma once
-// Input files (mobile meshes, WAV recordings, speed CSVs) are read whole, so only a regular file will do: a
-// FIFO or a device such as /dev/zero has no end and was read until memory ran out, without the file named.
+// Input files (mobile files, OBJ meshes, WAV recordings, speed CSVs, contact-law records) are read whole, so
+// only a regular file will do: a FIFO or a device such as /dev/zero has no end and was read until memory ran
+// out, without the file named.
 
 #include <string>
 

@@ -20,6 +20,7 @@
 #include "aloft/error.hpp"
 #include "aloft/geometry.hpp"
 #include "common/decimal_number.hpp"
+#include "common/regular_file.hpp"
 
 namespace aloft {
 namespace {
@@ -206,8 +207,7 @@ ObjMesh parse_obj_text(const std::string& text, const std::string& file_name_for
 }
 
 ObjMesh read_obj(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, {}, "cannot open file: it is a directory");
+  require_regular_file(path);  // a directory, a FIFO or /dev/zero (read until memory ran out)
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {

@@ -797,8 +797,7 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   if (!fs::exists(status)) fail(op, resolved + ": no such file");
   ObjMesh obj;
   try {
-    require_regular_file(resolved);  // "<resolved>: not a regular file"
-    obj = read_obj(resolved);
+    obj = read_obj(resolved);  // "<resolved>: not a regular file" for a directory or a device
   } catch (const InputError& e) {
     fail(op, e.what());
   }
