@@ -14,6 +14,8 @@
 #include <limits>
 #include <vector>
 
+#include "aloft/decimal_number.hpp"
+
 namespace aloft::cli {
 
 void print_error(const std::string& message) {
@@ -113,13 +115,11 @@ std::string source_dir() {
 }
 
 std::optional<double> read_number(const std::string& input) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(input, &used);
-    if (used == input.size()) return v;
-  } catch (const std::exception&) {
-  }
-  return std::nullopt;
+  // As the files' readers read numbers (no hexadecimal: std::stod took "0x2" for 2); inf and nan come back
+  // for the flags' checks to name.
+  double value = 0;
+  if (parse_double(input, value) == NumberResult::not_a_number) return std::nullopt;
+  return value;
 }
 
 namespace {

@@ -93,7 +93,8 @@ void check_outputs_apart(const std::vector<NamedFile>& inputs, const std::vector
 // Directory of the source tree this program was built from (for the preset mobiles).
 std::string source_dir();
 
-// The whole of `input` read as a number (std::stod: "1e5", "inf" and "nan" included), or nothing.
+// The whole of `input` read as a decimal number (aloft/decimal_number.hpp: "1e5", "inf" and "nan"
+// included, "0x2" not), or nothing.
 std::optional<double> read_number(const std::string& input);
 
 // The longest time a command runs the simulation or listens for (s): 11.6 days, 1e9 steps at 1 ms. The

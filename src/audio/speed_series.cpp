@@ -10,7 +10,7 @@
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
 #include "aloft/spec.hpp"
-#include "common/decimal_number.hpp"
+#include "aloft/decimal_number.hpp"
 #include "common/regular_file.hpp"
 
 namespace aloft {

@@ -19,7 +19,7 @@
 
 #include "aloft/error.hpp"
 #include "aloft/geometry.hpp"
-#include "common/decimal_number.hpp"
+#include "aloft/decimal_number.hpp"
 #include "common/regular_file.hpp"
 
 namespace aloft {

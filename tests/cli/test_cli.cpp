@@ -409,6 +409,8 @@ TEST_F(Cli, NumbersOutOfRangeSayTheRange) {
       // Steps and frames are counted in 64 bits: -t 1e300 overflowed them, and simulate ran one step and
       // render wrote one frame without a word; so did a step of 1e-300 s.
       {"simulate small.json -t 1e300", "--duration: must be a positive number of at most 1e+06 (s, 11.6 days), got 1e300"},
+      // Numbers are decimal, as in the files (std::stod read "0x1p-4" as 1/16 s).
+      {"simulate small.json -t 0x1p-4", "--duration: must be a number, got \"0x1p-4\""},
       {"render small.json -t 1e300 --out x.mp4", "--duration: must be a positive number of at most 1e+06"},
       {"simulate small.json -t 1 --dt 1e-300", "--dt: must be from 1e-06 to 0.01 s, got 1e-300"},
       // A NaN or far-away camera drew an empty image without a word.

@@ -1,7 +1,7 @@
 #pragma once
-// A whole text field as a decimal number, the same way in every text reader (OBJ meshes, speed CSVs):
-// std::from_chars, so no hexadecimal ("0x10" is not 16), no locale, and "inf" and "nan" are named as not
-// finite rather than taken; an optional leading '+', which writers sometimes emit.
+// A whole text field as a decimal number, the same way in every text reader (OBJ meshes, speed CSVs) and for
+// the command line's numbers: std::from_chars, so no hexadecimal ("0x10" is not 16), no locale, and "inf"
+// and "nan" are named as not finite rather than taken; an optional leading '+', which writers sometimes emit.
 
 #include <charconv>
 #include <cmath>
