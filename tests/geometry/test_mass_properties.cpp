@@ -364,8 +364,8 @@ TEST(MassProperties, AccumulatorKeepsTheInertiaOfSmallPartsFarFromTheOrigin) {
     const MassProperties mp = sphere_mass_properties(ball);
     MassAccumulator one;
     one.add(mp.volume, mp.center, mp.inertia);
-    // 1e-12 relative: one part, so only the centre's round-off (|c| eps ~ 1.6e-13 m, squared) enters.
-    EXPECT_NEAR((one.inertia_about_center() - mp.inertia).norm() / mp.inertia.norm(), 0, 1e-12) << radius;
+    // One part: its offset from the reference is exactly 0, so its inertia comes back bit for bit.
+    EXPECT_EQ(one.inertia_about_center(), mp.inertia) << radius;
     // Two balls a diameter apart: about their midpoint each adds m r^2, so 2 (2/5 + 1) m r^2 across the
     // line joining them and 2 (2/5) m r^2 along it. The offset 2r is known to |x| eps = 0.5 eps m, so to
     // 0.5 eps / (2r) relative, and its square twice that: 10 times that bound (about origin, the error was

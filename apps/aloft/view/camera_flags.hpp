@@ -42,9 +42,8 @@ struct CameraFlags {
         ->check(cli::number_in(5.0, 120.0))
         ->group("Camera");
     sub->add_option("--target", target,
-                    cli::format("Point the camera looks at: X Y Z or X,Y,Z as --wind-from takes it (m, world, each "
-                                "-%g to %g)",
-                                kLongestLength, kLongestLength))
+                    cli::format("Point the camera looks at: X Y Z or X,Y,Z (m, world, each -%g to %g)", kLongestLength,
+                                kLongestLength))
         ->type_name("X Y Z")
         ->expected(3)
         ->delimiter(',')
