@@ -239,8 +239,8 @@ std::optional<WindDriver> make_wind(const Model& model, const State& state, cons
     envelope.calibration_s = o.calibrate;
     // The follower's v0 is 0 while it calibrates: a recording no longer than the calibration would be the
     // room's sound throughout, and the run would go without wind and without a word.
-    const double calibration_frames = std::round(o.calibrate * clip.sample_rate);  // as the follower rounds it
-    if (o.noise_floor < 0 && o.calibrate > 0 && static_cast<double>(clip.frames()) <= calibration_frames)
+    const std::uint64_t calibrating = envelope.calibration_frames(clip.sample_rate);
+    if (o.noise_floor < 0 && calibrating > 0 && clip.frames() <= calibrating)
       throw InputError(o.audio, {},
                        format("the recording lasts %g s, no longer than the %g s of noise-floor calibration at its "
                               "start (--wind-calibrate), so no wind would blow; give --wind-calibrate 0 (or a "

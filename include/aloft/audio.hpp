@@ -46,6 +46,8 @@ struct EnvelopeSettings {
   double noise_floor = -1;     // RMS; >= 0: use this one and do not calibrate
   double max_v0 = 20;          // m/s, v0 is clamped to this
   void validate() const;       // throws std::invalid_argument naming the bad setting
+  // The samples the calibration takes at `sample_rate` (Hz), during which v0 is 0; 0 without calibration.
+  std::uint64_t calibration_frames(int sample_rate) const;
 };
 
 // Sample-by-sample envelope follower with noise-floor calibration. During calibration v0 is 0; the floor is

@@ -24,6 +24,10 @@ double smoothing_factor(double ms, int rate) {
 
 }  // namespace
 
+std::uint64_t EnvelopeSettings::calibration_frames(int sample_rate) const {
+  return calibration_s > 0 ? static_cast<std::uint64_t>(std::llround(calibration_s * sample_rate)) : 0;
+}
+
 void EnvelopeSettings::validate() const {
   require(std::isfinite(window_ms) && window_ms > 0 && window_ms <= 1000, "the RMS window must be in (0, 1000] ms");
   require(std::isfinite(attack_ms) && attack_ms >= 0 && attack_ms <= 10000, "the attack time must be in [0, 10000] ms");
@@ -55,7 +59,7 @@ void EnvelopeFollower::recalibrate() {
     return;
   }
   calibrating_ = true;
-  calibration_end_ = count_ + static_cast<std::uint64_t>(std::llround(settings_.calibration_s * rate_));
+  calibration_end_ = count_ + settings_.calibration_frames(rate_);
   calibration_levels_.clear();
 }
 
