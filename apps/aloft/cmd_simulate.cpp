@@ -6,12 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <optional>
+#include <variant>
+#include <vector>
 
 #include "aloft/contact_tally.hpp"
 #include "aloft/model.hpp"
 #include "aloft/simulation.hpp"
+#include "aloft/spec.hpp"
 #include "common.hpp"
 #include "contact_report.hpp"
 #include "progress.hpp"
@@ -151,11 +155,16 @@ Runner add_simulate(CLI::App& app) {
       "Exit code 3 if the simulation fails (its state stops being finite); the CSVs then hold the\n"
       "frames and contacts computed until then.\n");
   return [o] {
-    check_outputs_apart({{"the mobile file", o->file},
-                         {"--wind-audio's recording", o->wind.audio},
-                         {"--wind-speed's table", o->wind.speed_csv}},
-                        {{"--out", o->out}, {"--contacts-out", o->contacts_out}});
     LoadedMobile loaded = load_mobile_with_spec(o->file, o->balance);
+    std::vector<NamedFile> inputs = {{"the mobile file", o->file},
+                                     {"--wind-audio's recording", o->wind.audio},
+                                     {"--wind-speed's table", o->wind.speed_csv}};
+    for (const ComponentSpec& component : loaded.spec.components)
+      for (const ShapeSpec& shape : component.shapes)
+        if (const Mesh* mesh = std::get_if<Mesh>(&shape.shape))  // its file: relative to the mobile file's
+          inputs.push_back({"the mesh of " + shape.path,
+                            (std::filesystem::path(o->file).parent_path() / mesh->file).string()});
+    check_outputs_apart(inputs, {{"--out", o->out}, {"--contacts-out", o->contacts_out}});
     Model& model = loaded.model;
     if (o->no_collisions) model.contact.enabled = false;
     Simulation sim(model);

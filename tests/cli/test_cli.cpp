@@ -206,6 +206,23 @@ TEST_F(Cli, OutputsNeverOverwriteTheInputs) {
   }
   EXPECT_EQ(read(dir_ / "small.json"), kSmallMobile);
   EXPECT_FALSE(fs::exists(dir_ / "a.csv"));
+  // Nor on a mesh the mobile file names (relative to the mobile file, here in sub/).
+  const std::string cube =
+      "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\n"
+      "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n"
+      "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+  write(dir_ / "sub" / "ball.obj", cube);
+  std::string meshed = kSmallMobile;
+  const std::string sphere = R"({"sphere": {"center": [0.5, 1.54, 0], "radius": 0.06}})";
+  meshed.replace(meshed.find(sphere), sphere.size(),
+                 R"({"mesh": {"obj": "ball.obj", "scale": 0.1, "translate": [0.5, 1.54, 0]}})");
+  write(dir_ / "sub" / "meshed.json", meshed);
+  const Result r = aloft("simulate sub/meshed.json -t 0.01 -o sub/ball.obj");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("--out: sub/ball.obj is the mesh of components[3].shapes[1]; writing it would destroy it"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(read(dir_ / "sub" / "ball.obj"), cube);
   // Two different outputs still work.
   EXPECT_EQ(aloft("simulate small.json -t 0.01 -q -o a.csv --contacts-out b.csv").code, 0);
 }
