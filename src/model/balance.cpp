@@ -128,22 +128,24 @@ BalanceResult balance(const BalanceInput& in, BalanceMode mode, std::optional<do
           why << (too_unequal ? "cannot balance with masses within a factor 1e6 of the drawn ones: around its joint "
                               : "cannot balance with positive masses: around its joint ")
               << format_point(in.joint[i]) << ", the weight of ";
+          // The parts whose factor is too small (too unequal: the smallest alone, with its factor).
           const char* separator = "";
-          if (x(0) <= 1e-6) {
-            why << "'" << in.names[i] << "' itself";
+          for (Eigen::Index j = 0; j < x.size(); ++j) {
+            if (x(j) > 1e-6 || (too_unequal && x(j) != smallest)) continue;
+            if (j == 0) {
+              why << separator << "'" << in.names[i] << "' itself";
+            } else {
+              const int child = in.children[i][static_cast<std::size_t>(j - 1)];
+              why << separator << "'" << in.names[child] << "'"
+                  << (in.children[child].empty() ? "" : " with what hangs from it");
+            }
             separator = " and of ";
-          }
-          for (size_t j = 0; j < in.children[i].size(); ++j) {
-            const int child = in.children[i][j];
-            if (x(j + 1) > 1e-6) continue;
-            why << separator << "'" << in.names[child] << "'"
-                << (in.children[child].empty() ? "" : " with what hangs from it");
-            separator = " and of ";
+            if (too_unequal) break;
           }
           if (too_unequal)
             why << " would have to be " << std::setprecision(3) << 1 / smallest
-                << " times less than its shapes and density give: the parts' masses are too unequal for the "
-                   "arms they hang from; move the joint towards the heavier side, or use balance mode \"joints\"";
+                << " times lighter than drawn: the parts' masses are too unequal for the arms they hang from; "
+                   "move the joint towards the heavier side, or use balance mode \"joints\"";
           else
             why << " would have to be zero or negative: the pieces hanging from it do not lie on both sides "
                    "of the joint; move the joint between them, or use balance mode \"joints\"";
