@@ -11,6 +11,7 @@
 #include "aloft/error.hpp"
 #include "aloft/spec.hpp"
 #include "aloft/decimal_number.hpp"
+#include "common/printable.hpp"
 #include "common/regular_file.hpp"
 
 namespace aloft {
@@ -37,11 +38,11 @@ std::string trim(const std::string& s) {
 // (std::strtod read "0x10" as 16) or not finite ("inf", "nan", "1e400"); empty when nothing more is known.
 std::string number_problem(const std::string& field, NumberResult result, const char* name) {
   const std::string text = trim(field);
-  if (result == NumberResult::not_finite) return std::string(name) + " must be a finite number, got " + text;
+  if (result == NumberResult::not_finite) return std::string(name) + " must be a finite number, got " + printable(text);
   std::string_view digits = without_plus(text);
   if (!digits.empty() && digits[0] == '-') digits.remove_prefix(1);
   if (digits.size() > 1 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
-    return std::string(name) + " must be a decimal number, got the hexadecimal " + text;
+    return std::string(name) + " must be a decimal number, got the hexadecimal " + printable(text);
   return "";
 }
 
@@ -62,7 +63,8 @@ SpeedSeries read_speed_csv(const std::string& path) {
     if (text.empty() || text[0] == '#') continue;
     const auto comma = text.find(',');
     auto fail = [&](const std::string& problem) { throw InputError(path, SourcePlace{"", number, 0}, problem); };
-    if (comma == std::string::npos) fail("expected \"t,v0\" (time in s, speed in m/s), got \"" + text + "\"");
+    if (comma == std::string::npos)
+      fail("expected \"t,v0\" (time in s, speed in m/s), got \"" + printable(text) + "\"");
     double t = 0, v = 0;
     const NumberResult t_read = parse_double(trim(text.substr(0, comma)), t);
     const NumberResult v_read = parse_double(trim(text.substr(comma + 1)), v);
@@ -73,7 +75,7 @@ SpeedSeries read_speed_csv(const std::string& path) {
     if (t_read != NumberResult::ok || v_read != NumberResult::ok) {
       // A header line such as "t,v0": neither field a number.
       if (series.t.empty() && t_read != NumberResult::ok && v_read != NumberResult::ok) continue;
-      fail("expected two numbers \"t,v0\", got \"" + text + "\"");
+      fail("expected two numbers \"t,v0\", got \"" + printable(text) + "\"");
     }
     if (!acceptable_wind_speed(v)) fail("the speed v0 " + wind_speed_rule() + ", got " + trim(text.substr(comma + 1)));
     if (!series.t.empty() && t <= series.t.back())

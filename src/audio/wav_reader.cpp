@@ -13,6 +13,7 @@
 #include "aloft/audio.hpp"
 #include "aloft/error.hpp"
 #include "common/little_endian.hpp"
+#include "common/printable.hpp"
 #include "common/regular_file.hpp"
 
 namespace aloft {
@@ -45,21 +46,12 @@ struct Reader {
     const auto first = bytes.begin() + static_cast<std::ptrdiff_t>(at);
     return std::all_of(first, first + 4, [](std::uint8_t c) { return c >= 0x20 && c < 0x7f; });
   }
-  // The tag at `at` for a message, in quotes, every byte that is not printable ASCII (and the quote and
-  // backslash) as \xNN: a damaged tag's NUL byte used to cut the message short.
+  // The tag at `at` for a message, in quotes (common/printable.hpp: a damaged tag's NUL byte used to cut
+  // the message short).
   std::string tag_text(std::size_t at) const {
     std::string out = "\"";
-    for (std::size_t i = at; i < at + 4; ++i) {
-      const std::uint8_t c = bytes[i];
-      if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
-        out += static_cast<char>(c);
-      } else {
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "\\x%02X", static_cast<unsigned>(c));
-        out += hex;
-      }
-    }
-    return out + "\"";
+    out += printable(std::string_view(reinterpret_cast<const char*>(bytes.data() + at), 4));
+    return out += "\"";
   }
 };
 

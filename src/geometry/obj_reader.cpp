@@ -20,6 +20,7 @@
 #include "aloft/error.hpp"
 #include "aloft/geometry.hpp"
 #include "aloft/decimal_number.hpp"
+#include "common/printable.hpp"
 #include "common/regular_file.hpp"
 
 namespace aloft {
@@ -38,16 +39,11 @@ struct Token {
   int column = 0;
 };
 
-// The token quoted for a message: at most 40 bytes, bytes that are not printable ASCII shown as '?'.
+// The token quoted for a message: at most 40 bytes (common/printable.hpp).
 std::string quoted(std::string_view s) {
-  constexpr size_t kMax = 40;
   std::string out = "'";
-  for (size_t i = 0; i < s.size() && i < kMax; ++i) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    out += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
-  }
-  if (s.size() > kMax) out += "...";
-  return out + "'";
+  out += printable(s, 40);
+  return out += "'";
 }
 
 // A whole token as a decimal integer (optional sign).
