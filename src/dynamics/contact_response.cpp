@@ -10,6 +10,10 @@ namespace aloft {
 
 namespace {
 
+// The normal velocity (m/s, negative: closing) a contact may be left with: a gap of `distance` (m) may close
+// within the step of h (s) but not pass it (a speculative contact); an overlap may not grow.
+double closing_allowed(const Contact& c, double h) { return -std::max(c.distance, 0.0) / h; }
+
 // An orthonormal basis (n, t1, t2) as matrix columns, t1 chosen away from n's largest component.
 Mat3 contact_basis(const Vec3& n) {
   const Vec3 helper = std::abs(n.x()) < 0.6 ? Vec3::UnitX() : Vec3::UnitY();
@@ -312,7 +316,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       // (A pair pressed together bounces only when knocked: see start_step's declaration.)
       const bool collides =
           un < -threshold && c.distance + un * h <= 0 && -un > 2.0 * pressed_recently(c.a, c.b);
-      rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
+      rows_[k].target_normal = closing_allowed(c, h);
       if (restitution && collides && e > 0) {
         rows_[k].target_normal = -e * un;
         any_bounce = true;
@@ -370,7 +374,7 @@ ContactStepReport ContactResponse::resolve(const State& pose, TreeSolver& solver
       // within the step, and what it keeps of its approach was not stopped (counted, a ball slowed from 1.14
       // to 0.93 m/s before a knock then met that knock as pressed, and did not bounce).
       pressing_.push_back({contacts[k].a, contacts[k].b,
-                           std::max(-u_[3 * k] - std::max(contacts[k].distance, 0.0) / h, 0.0)});
+                           std::max(closing_allowed(contacts[k], h) - u_[3 * k], 0.0)});
     }
   // The law's energy change, u^T P + P^T K P / 2, is weighed at the half-kicked velocities u; the step's
   // is weighed at its start velocities u_start = u - (what the half kick did at the contact):
@@ -446,7 +450,7 @@ bool ContactResponse::solve_correction(double h, const std::vector<Vec3>& veloci
   for (int k = 0; k < m; ++k) {
     const Contact& c = contacts[k];
     u_.segment<3>(3 * k) = basis_[k].transpose() * relative_velocity(c, arm_a_[k], arm_b_[k], velocity, angular);
-    rows_[k].target_normal = -std::max(c.distance, 0.0) / h;
+    rows_[k].target_normal = closing_allowed(c, h);
     needed = needed || u_[3 * k] < rows_[k].target_normal - tolerance;
   }
   if (!needed) return false;
