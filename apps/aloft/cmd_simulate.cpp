@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <optional>
 #include <variant>
@@ -161,9 +160,8 @@ Runner add_simulate(CLI::App& app) {
                                      {"--wind-speed's table", o->wind.speed_csv}};
     for (const ComponentSpec& component : loaded.spec.components)
       for (const ShapeSpec& shape : component.shapes)
-        if (const Mesh* mesh = std::get_if<Mesh>(&shape.shape))  // its file: relative to the mobile file's
-          inputs.push_back({"the mesh of " + shape.path,
-                            (std::filesystem::path(o->file).parent_path() / mesh->file).string()});
+        if (const Mesh* mesh = std::get_if<Mesh>(&shape.shape))
+          inputs.push_back({"the mesh of " + shape.path, mesh->opened});
     check_outputs_apart(inputs, {{"--out", o->out}, {"--contacts-out", o->contacts_out}});
     Model& model = loaded.model;
     if (o->no_collisions) model.contact.enabled = false;

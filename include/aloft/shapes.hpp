@@ -52,6 +52,7 @@ struct Plate {
 struct Mesh {
   std::string file;                    // as written in the mobile file (relative to it)
   TriangleMesh mesh;                   // world coordinates
+  std::string opened;                  // the path it was read from: `file` resolved against the mobile file's directory
 };
 
 using Shape = std::variant<Sphere, Wire, Box, Plate, Mesh>;

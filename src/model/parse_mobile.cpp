@@ -791,7 +791,8 @@ Mesh Reader::mesh(const json& v, const Path& path) const {
   }
   if (const json* t = find(v, "translate")) translate = point(*t, join(path, "translate"));
 
-  const std::string resolved = (fs::path(base_dir_) / fs::path(m.file)).lexically_normal().string();
+  m.opened = (fs::path(base_dir_) / fs::path(m.file)).lexically_normal().string();
+  const std::string& resolved = m.opened;
   std::error_code ec;
   const fs::file_status status = fs::status(resolved, ec);
   if (!fs::exists(status)) fail(op, resolved + ": no such file");

@@ -348,7 +348,7 @@ TEST(NarrowPhase, BoxAndMeshPieces) {
   ASSERT_TRUE(g);
   EXPECT_NEAR(g->distance, 0.1, 1e-12);  // point against a polytope: exact up to round-off
   EXPECT_NEAR(g->normal.y(), 1, 1e-12);
-  const Mesh mesh{"box.obj", shape_mesh(box)};
+  const Mesh mesh{"box.obj", shape_mesh(box), "box.obj"};
   const auto m = contact(ball, mesh, 0.102);
   ASSERT_TRUE(m);
   EXPECT_NEAR(m->distance, 0.1, 1e-12);
