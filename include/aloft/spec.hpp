@@ -149,6 +149,8 @@ inline constexpr double kDensestWind = 1000.0;
 // came from and ends with what it was: "<place>: must be a positive number of at most ..., got 1e300".
 bool acceptable_wind_alpha(double alpha, double l0);
 std::string wind_alpha_rule(double l0);
+// The largest alpha that rule allows at l0 (m): kDensestWind * l0^4 (kg m), water's.
+double largest_wind_alpha(double l0);
 
 // A wind source the file places in the room (a fan, an air vent): the paper's cone with its disc S0
 // centred at `from`, blowing towards `to`, the vertex l0 behind S0 (WindSource::aimed(from, to, r0, l0)).

@@ -18,8 +18,10 @@ std::string wind_speed_rule() {
 
 bool acceptable_wind_speed(double v0) { return v0 >= 0 && v0 <= kFastestWind; }
 
+double largest_wind_alpha(double l0) { return kDensestWind * std::pow(l0, 4); }
+
 bool acceptable_wind_alpha(double alpha, double l0) {
-  return alpha > 0 && alpha <= kDensestWind * std::pow(l0, 4);  // NaN fails
+  return alpha > 0 && alpha <= largest_wind_alpha(l0);  // NaN fails
 }
 
 std::string wind_alpha_rule(double l0) {
@@ -27,7 +29,7 @@ std::string wind_alpha_rule(double l0) {
   std::snprintf(text, sizeof text,
                 "must be a positive number of at most %g kg m: alpha = rho l0^4, and with l0 = %g m that is water's "
                 "density, %g kg/m^3 (air's alpha is %.4g kg m)",
-                kDensestWind * std::pow(l0, 4), l0, kDensestWind, kAirDensity * std::pow(l0, 4));
+                largest_wind_alpha(l0), l0, kDensestWind, kAirDensity * std::pow(l0, 4));
   return text;
 }
 

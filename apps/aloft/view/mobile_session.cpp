@@ -228,7 +228,7 @@ bool MobileSession::update_wind(const Vec3& camera_forward) {
   }
   // A set alpha keeps the files' rule at this l0 (at most water's, kDensestWind l0^4): a shorter l0
   // takes it down with it.
-  w.settings.alpha = std::min(w.settings.alpha, kDensestWind * std::pow(w.l0, 4));
+  w.settings.alpha = std::min(w.settings.alpha, largest_wind_alpha(w.l0));
   try {
     WindSource source = source_facing_mobile(*model_, sim_->state(), w.along, w.distance, w.l0);
     if (w.r0 > 0) source.r0 = w.r0;

@@ -296,7 +296,7 @@ void ViewerState::draw_panel() {
     // alpha within water's when l0 shrinks).
     const double l0_4 = std::pow(w.l0, 4);
     const float alpha_lo = static_cast<float>(kAirDensity * l0_4 / 100);
-    const float alpha_hi = static_cast<float>(kDensestWind * l0_4);
+    const float alpha_hi = static_cast<float>(largest_wind_alpha(w.l0));
     float alpha = static_cast<float>(session->wind() ? session->wind()->alpha() : kAirDensity * l0_4);
     if (bounded_slider("alpha (kg m)", alpha, alpha_lo, alpha_hi, "%.3g", ImGuiSliderFlags_Logarithmic))
       w.settings.alpha = alpha;
