@@ -7,10 +7,7 @@
 #include <cerrno>
 #include <charconv>
 #include <climits>
-#include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string_view>
